@@ -1,0 +1,364 @@
+/* bench_field: how well and how fast the radiance-field engine fits and renders.
+ *
+ *   chair  NeRF-synthetic chair 200x200: train 1, 2, 3 and 5 minutes (separate runs, each on
+ *          its own schedule), PSNR/SSIM on the 10 test views (targets: >= 29 dB at 1 min,
+ *          >= 32 dB at 3 min)
+ *   lego   NeRF-synthetic lego: every 10th training view held out, 3 minutes, PSNR on them
+ *          (target >= 30 dB)
+ *   fox    instant-ngp fox (real photos, distortion, background kept): every 8th photo held
+ *          out, 3 minutes, PSNR on them (target >= 22 dB)
+ *   render median time of a 224x224 classifier-camera render of the chair (target < 25 ms)
+ *
+ * Peak memory is the process's resident high-water mark during each training run. Timings
+ * are wall clock on all cores; expect +-10% when other work shares the machine.
+ *
+ * usage: bench_field [SCENE...] [--minutes 1,2,3,5] [--set option=value]... */
+#define _GNU_SOURCE
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vf/dataset.h"
+#include "vf/field.h"
+#include "vf/image.h"
+#include "vf/log.h"
+#include "vf/metrics.h"
+#include "vf/pose.h"
+#include "vf/resources.h"
+#include "vf/rng.h"
+
+typedef struct view_set {
+    int count;
+    vf_camera *cameras;
+    double *c2w;
+    vf_image *images;
+} view_set;
+
+static void view_set_free(view_set *s)
+{
+    for (int i = 0; i < s->count; i++)
+        vf_image_free(&s->images[i]);
+    free(s->cameras);
+    free(s->c2w);
+    free(s->images);
+    memset(s, 0, sizeof *s);
+}
+
+static void die(const char *what)
+{
+    fprintf(stderr, "bench_field: %s: %s\n", what, vf_error_message());
+    exit(2);
+}
+
+/* Load a transforms file; frames with index % holdout_every == 0 go to `held` (when
+ * holdout_every > 0), the rest to `train`. */
+static void load_views(const char *relative, int holdout_every, view_set *train, view_set *held)
+{
+    char path[4096];
+    vf_dataset ds;
+    if (vf_shared_path(relative, path, sizeof path) != VF_OK || vf_dataset_load(path, &ds) != VF_OK)
+        die(relative);
+    view_set *sets[2] = {train, held};
+    for (int k = 0; k < 2; k++) {
+        if (!sets[k])
+            continue;
+        memset(sets[k], 0, sizeof *sets[k]);
+        sets[k]->cameras = calloc((size_t)ds.count, sizeof(vf_camera));
+        sets[k]->c2w = calloc((size_t)ds.count, 16 * sizeof(double));
+        sets[k]->images = calloc((size_t)ds.count, sizeof(vf_image));
+    }
+    int failed = 0;
+    for (int i = 0; i < ds.count; i++) {
+        int to_held = holdout_every > 0 && i % holdout_every == 0;
+        view_set *s = to_held ? held : train;
+        if (!s)
+            continue;
+        s->cameras[s->count] = ds.frames[i].camera;
+        memcpy(s->c2w + 16 * s->count, ds.frames[i].c2w, 16 * sizeof(double));
+        s->images[s->count].data = NULL;
+        /* remember the path in the image slot's order; decode below */
+        s->count++;
+    }
+    /* decode in parallel, in the same order */
+    int ti = 0, hi = 0;
+    int *slot = malloc(sizeof(int) * (size_t)ds.count);
+    view_set **owner = malloc(sizeof(view_set *) * (size_t)ds.count);
+    for (int i = 0; i < ds.count; i++) {
+        int to_held = holdout_every > 0 && i % holdout_every == 0;
+        owner[i] = to_held ? held : train;
+        slot[i] = to_held ? hi++ : ti++;
+    }
+#pragma omp parallel for schedule(dynamic)
+    for (int i = 0; i < ds.count; i++) {
+        if (!owner[i])
+            continue;
+        if (vf_image_load(ds.frames[i].image_path, &owner[i]->images[slot[i]]) != VF_OK) {
+#pragma omp atomic write
+            failed = 1;
+        }
+    }
+    free(slot);
+    free(owner);
+    vf_dataset_free(&ds);
+    if (failed)
+        die("loading images");
+}
+
+/* The RGB the field should reproduce: alpha composited on the background. */
+static void target_rgb(const vf_image *img, const float bg[3], vf_image *out)
+{
+    if (vf_image_to_rgb(img, bg, out) != VF_OK)
+        die("converting an image");
+}
+
+/* Reset the resident high-water mark (Linux: 5 > /proc/self/clear_refs). */
+static void reset_peak_memory(void)
+{
+    FILE *fp = fopen("/proc/self/clear_refs", "w");
+    if (fp) {
+        fputs("5", fp);
+        fclose(fp);
+    }
+}
+
+static double peak_memory_mib(void)
+{
+    FILE *fp = fopen("/proc/self/status", "r");
+    char line[256];
+    double kib = 0;
+    while (fp && fgets(line, sizeof line, fp))
+        if (!strncmp(line, "VmHWM:", 6))
+            kib = atof(line + 6);
+    if (fp)
+        fclose(fp);
+    return kib / 1024.0;
+}
+
+/* --set name=value: override a training option (for tuning). */
+static void apply_setting(vf_field_train_options *o, const char *text)
+{
+    char name[64];
+    const char *eq = strchr(text, '=');
+    if (!eq || eq - text >= (long)sizeof name) {
+        fprintf(stderr, "bench_field: --set wants name=value\n");
+        exit(1);
+    }
+    memcpy(name, text, (size_t)(eq - text));
+    name[eq - text] = '\0';
+    double v = atof(eq + 1);
+    if (!strcmp(name, "batch_rays")) o->batch_rays = (int)v;
+    else if (!strcmp(name, "max_points")) o->max_points = v;
+    else if (!strcmp(name, "levels")) o->levels = (int)v;
+    else if (!strcmp(name, "upsample_end")) o->upsample_end = v;
+    else if (!strcmp(name, "lr_density")) o->lr_density = (float)v;
+    else if (!strcmp(name, "lr_color")) o->lr_color = (float)v;
+    else if (!strcmp(name, "tv_density")) o->tv_density = (float)v;
+    else if (!strcmp(name, "tv_color")) o->tv_color = (float)v;
+    else if (!strcmp(name, "box_scale")) o->box_scale = (float)v;
+    else if (!strcmp(name, "background_scale")) o->background_scale = (float)v;
+    else if (!strcmp(name, "keep_background")) o->keep_background = (int)v;
+    else if (!strcmp(name, "steps")) { o->steps = (int)v; o->seconds = 0; }
+    else if (!strcmp(name, "seed")) o->seed = (uint64_t)v;
+    else {
+        fprintf(stderr, "bench_field: unknown option %s\n", name);
+        exit(1);
+    }
+}
+
+static double progress_every = 5;
+
+typedef struct run_result {
+    double psnr, ssim, train_seconds, peak_mib;
+    int steps;
+} run_result;
+
+static vf_field *train(const vf_field_train_options *opt, const view_set *views, run_result *r)
+{
+    vf_field_trainer *t;
+    reset_peak_memory();
+    if (vf_field_trainer_create(opt, &t) != VF_OK)
+        die("trainer");
+    for (int i = 0; i < views->count; i++)
+        if (vf_field_trainer_add_view(t, &views->cameras[i], views->c2w + 16 * i,
+                                      &views->images[i]) != VF_OK)
+            die("adding a view");
+    if (vf_field_trainer_start(t) != VF_OK)
+        die("starting");
+    vf_field_train_status st;
+    double last = vf_now();
+    do {
+        if (vf_field_trainer_step(t, &st) != VF_OK)
+            die("training");
+        if (vf_now() - last > progress_every || st.done) {
+            fprintf(stderr,
+                    "  step %5d  %5.1f s  level %d  loss %.5f  train psnr %.2f  %.0f samples/ray  "
+                    "%.0f + %.0f ms  %.2fM touched  %.1f%% occupied\n",
+                    st.step, st.elapsed, st.level, st.loss, st.psnr, st.samples_per_ray, st.step_ms,
+                    st.optimizer_ms, st.touched_points / 1e6, 100 * st.occupied);
+            last = vf_now();
+        }
+    } while (!st.done);
+    r->train_seconds = st.elapsed;
+    r->steps = st.step;
+    r->peak_mib = peak_memory_mib();
+    vf_field *f = vf_field_trainer_take_field(t);
+    vf_field_trainer_free(t);
+    return f;
+}
+
+static void evaluate(const vf_field *f, const view_set *test, const float bg[3], run_result *r)
+{
+    double psnr = 0, ssim = 0;
+    for (int i = 0; i < test->count; i++) {
+        vf_image render = {0}, truth = {0};
+        if (vf_field_render(f, &test->cameras[i], test->c2w + 16 * i, &render) != VF_OK)
+            die("rendering");
+        target_rgb(&test->images[i], bg, &truth);
+        psnr += vf_image_psnr(&render, &truth);
+        ssim += vf_image_ssim(&render, &truth);
+        vf_image_free(&render);
+        vf_image_free(&truth);
+    }
+    r->psnr = psnr / test->count;
+    r->ssim = ssim / test->count;
+}
+
+static void print_run(const char *scene, double minutes, const run_result *r, double target)
+{
+    printf("%-6s %4.1f min  %5d steps  PSNR %6.2f dB  SSIM %.4f  peak %6.0f MiB  %s\n", scene,
+           minutes, r->steps, r->psnr, r->ssim, r->peak_mib,
+           target > 0 ? (r->psnr >= target ? "(target met)" : "(BELOW TARGET)") : "");
+    fflush(stdout);
+}
+
+static void bench_render(const vf_field *f)
+{
+    vf_camera cam = vf_field_classifier_camera(f, 224);
+    vf_rng rng;
+    vf_rng_seed(&rng, 7);
+    enum { N = 60 };
+    double times[N];
+    vf_image img = {0};
+    double lo[6], hi[6];
+    vf_viewpoint_bounds(lo, hi);
+    for (int i = 0; i < N; i++) {
+        double a[6];
+        for (int k = 0; k < 6; k++)
+            a[k] = lo[k] + (hi[k] - lo[k]) * vf_rng_uniform(&rng);
+        vf_viewpoint v = vf_viewpoint_from_array(a);
+        double c2w[16];
+        vf_viewpoint_to_c2w(&v, c2w);
+        double t0 = vf_now();
+        if (vf_field_render(f, &cam, c2w, &img) != VF_OK)
+            die("render");
+        times[i] = (vf_now() - t0) * 1000;
+    }
+    /* median: sort */
+    for (int i = 1; i < N; i++)
+        for (int j = i; j > 0 && times[j] < times[j - 1]; j--) {
+            double s = times[j];
+            times[j] = times[j - 1];
+            times[j - 1] = s;
+        }
+    printf("render 224x224 (random ViewFool viewpoints, %d threads): median %.1f ms, min %.1f, "
+           "max %.1f  %s\n",
+           omp_get_max_threads(), times[N / 2], times[0], times[N - 1],
+           times[N / 2] < 25 ? "(target met)" : "(BELOW TARGET)");
+    vf_image_free(&img);
+}
+
+int main(int argc, char **argv)
+{
+    vf_field_train_options base;
+    vf_field_train_defaults(&base);
+    double minutes[8] = {1, 2, 3, 5};
+    int minute_count = 4;
+    int want_chair = 0, want_lego = 0, want_fox = 0, want_render = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--minutes") && i + 1 < argc) {
+            minute_count = 0;
+            for (char *p = argv[++i]; *p && minute_count < 8;) {
+                minutes[minute_count++] = strtod(p, &p);
+                if (*p == ',')
+                    p++;
+            }
+        } else if (!strcmp(argv[i], "--set") && i + 1 < argc) {
+            apply_setting(&base, argv[++i]);
+        } else if (!strcmp(argv[i], "chair")) {
+            want_chair = 1;
+        } else if (!strcmp(argv[i], "lego")) {
+            want_lego = 1;
+        } else if (!strcmp(argv[i], "fox")) {
+            want_fox = 1;
+        } else if (!strcmp(argv[i], "render")) {
+            want_render = 1;
+        } else {
+            fprintf(stderr, "usage: bench_field [chair] [lego] [fox] [render] [--minutes 1,2,3,5] "
+                            "[--set option=value]...\n");
+            return 1;
+        }
+    }
+    if (!want_chair && !want_lego && !want_fox && !want_render)
+        want_chair = want_lego = want_fox = want_render = 1;
+    vf_log_set_quiet(1);
+    const float white[3] = {1, 1, 1};
+
+    if (want_chair || want_render) {
+        view_set train_views, test_views;
+        load_views("data/nerf_synthetic/chair/transforms_train.json", 0, &train_views, NULL);
+        load_views("data/nerf_synthetic/chair/transforms_test.json", 0, &test_views, NULL);
+        vf_field *last = NULL;
+        for (int m = 0; want_chair && m < minute_count; m++) {
+            vf_field_train_options opt = base;
+            opt.seconds = base.seconds > 0 ? minutes[m] * 60 : 0;
+            run_result r;
+            vf_field *f = train(&opt, &train_views, &r);
+            evaluate(f, &test_views, white, &r);
+            double target = minutes[m] == 1 ? 29 : minutes[m] == 3 ? 32 : 0;
+            print_run("chair", r.train_seconds / 60, &r, target);
+            vf_field_free(last);
+            last = f;
+        }
+        if (want_render) {
+            if (!last) {
+                vf_field_train_options opt = base;
+                opt.seconds = base.seconds > 0 ? 60 : 0;
+                run_result r;
+                last = train(&opt, &train_views, &r);
+            }
+            bench_render(last);
+        }
+        vf_field_free(last);
+        view_set_free(&train_views);
+        view_set_free(&test_views);
+    }
+    if (want_lego) {
+        view_set train_views, held;
+        load_views("data/nerf_synthetic/lego/transforms_train.json", 10, &train_views, &held);
+        vf_field_train_options opt = base;
+        opt.seconds = base.seconds > 0 ? 180 : 0;
+        run_result r;
+        vf_field *f = train(&opt, &train_views, &r);
+        evaluate(f, &held, white, &r);
+        print_run("lego", r.train_seconds / 60, &r, 30);
+        vf_field_free(f);
+        view_set_free(&train_views);
+        view_set_free(&held);
+    }
+    if (want_fox) {
+        view_set train_views, held;
+        load_views("data/real_captures/instant_ngp_fox/transforms.json", 8, &train_views, &held);
+        vf_field_train_options opt = base;
+        opt.seconds = base.seconds > 0 ? 180 : 0;
+        opt.keep_background = 1;
+        run_result r;
+        vf_field *f = train(&opt, &train_views, &r);
+        evaluate(f, &held, white, &r);
+        print_run("fox", r.train_seconds / 60, &r, 22);
+        vf_field_free(f);
+        view_set_free(&train_views);
+        view_set_free(&held);
+    }
+    return 0;
+}

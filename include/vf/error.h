@@ -1,0 +1,43 @@
+/* vf/error.h: how every vfcapture function reports failure.
+ *
+ * A fallible function returns a vf_status. On failure it records one human-readable line
+ * (what was wrong and, where possible, what to do) in a thread-local buffer with vf_fail();
+ * the caller may add context with vf_error_prefix() and the command line prints it once.
+ * The status values double as the process exit codes. The message buffer is owned by the
+ * library; callers only read it. */
+#ifndef VF_ERROR_H
+#define VF_ERROR_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    VF_OK = 0,        /* success */
+    VF_EINPUT = 1,    /* the user's input is wrong: missing file, bad value, unusable data */
+    VF_EINTERNAL = 2  /* something failed that the user could not have prevented */
+} vf_status;
+
+/* Record a formatted message and return code, so callers can write `return vf_fail(...)`. */
+vf_status vf_fail(vf_status code, const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* Prepend "context: " to the current message (for example the file being processed). */
+void vf_error_prefix(const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+
+/* The last message recorded on this thread ("" when none). */
+const char *vf_error_message(void);
+
+void vf_error_clear(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

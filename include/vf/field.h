@@ -1,0 +1,192 @@
+/* vf/field.h: radiance fields: fit one to posed photos of an object, render new views of it.
+ *
+ * A vf_field is an explicit voxel grid (density plus degree-1 spherical-harmonics colour),
+ * trained on the CPU in minutes and rendered in milliseconds by ray marching with empty-space
+ * skipping and early termination. Typical use:
+ *
+ *     vf_field_trainer *t;
+ *     vf_field_train_options opt;
+ *     vf_field_train_defaults(&opt);
+ *     opt.seconds = 180;
+ *     vf_field_trainer_create(&opt, &t);
+ *     for (each posed image)
+ *         vf_field_trainer_add_view(t, &camera, c2w, &image);  // copied; free yours after
+ *     vf_field_trainer_start(t);
+ *     while (vf_field_trainer_step(t, &status) == VF_OK && !status.done)
+ *         ... report status, checkpoint now and then ...
+ *     vf_field_save(vf_field_trainer_field(t), "model.vff");
+ *     vf_field_trainer_free(t);
+ *
+ *     vf_field *f;
+ *     vf_field_load("model.vff", &f);
+ *     vf_image img = {0};
+ *     vf_field_render(f, &camera, c2w, &img);   // allocates img; vf_image_free() it
+ *     vf_field_free(f);
+ *
+ * Conventions: camera-to-world matrices are row-major 4x4 doubles in OpenGL camera axes (x
+ * right, y up, looking along -z), as in vf/dataset.h. Rendered images are 3-channel float RGB
+ * in 0..1, the field's background colour where rays see nothing.
+ *
+ * Threads: rendering and training use every core (OpenMP). A vf_field may be rendered from
+ * several threads at once; a trainer is used by one thread.
+ *
+ * Memory: create/load functions allocate the object; the caller frees it with the matching
+ * free function. Images passed in are borrowed (copied where kept); images filled by a
+ * render function belong to the caller. */
+#ifndef VF_FIELD_H
+#define VF_FIELD_H
+
+#include <stdint.h>
+
+#include "vf/camera.h"
+#include "vf/error.h"
+#include "vf/image.h"
+#include "vf/pose.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vf_field vf_field;
+
+/* ---- rendering --------------------------------------------------------------------------- */
+
+/* Render the view of camera `cam` placed at c2w into `out` (RGB float). When out->data is
+ * NULL, or out's size or channel count differ from the camera's, out is (re)allocated;
+ * otherwise its pixels are overwritten in place, so a render loop allocates nothing. */
+vf_status vf_field_render(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                          vf_image *out);
+
+/* Render n views (c2w: n row-major 4x4 matrices, one after another) with the same camera into
+ * out[0..n-1], each handled as in vf_field_render. For the attack loop: no file I/O, and no
+ * allocation after the first call with the same images. */
+vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const double *c2w, int n,
+                                vf_image *out);
+
+/* Render n ViewFool viewpoints (vf/pose.h: vf_viewpoint_to_c2w) with the same camera into
+ * out[0..n-1], as vf_field_render_batch does. This is the attack's renderer. */
+vf_status vf_field_render_viewpoints(const vf_field *f, const vf_camera *cam,
+                                     const vf_viewpoint *viewpoints, int n, vf_image *out);
+
+/* Render the expected ray depth (world units along the ray; 0 where nothing was hit) and
+ * the accumulated opacity into two 1-channel images (either may be NULL). Allocation as in
+ * vf_field_render. */
+vf_status vf_field_render_depth(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                                vf_image *depth, vf_image *opacity);
+
+/* The pinhole camera whose size x size image equals what a classifier sees of a training
+ * photo: the photo resized so its shorter side is size * 256 / 224, then centre-cropped to
+ * size x size (vf_classifier_preprocess). Lens distortion is dropped. */
+vf_camera vf_field_classifier_camera(const vf_field *f, int size);
+
+/* A reference training camera (intrinsics of the first view the field was trained on). */
+vf_camera vf_field_training_camera(const vf_field *f);
+
+/* The colour of rays that see nothing (white for objects on transparent backgrounds). */
+void vf_field_background(const vf_field *f, float rgb[3]);
+void vf_field_set_background(vf_field *f, const float rgb[3]);
+
+/* Facts about a field, for reports. */
+typedef struct vf_field_info {
+    int dim[3];              /* grid points of the object grid */
+    float box_lo[3], box_hi[3]; /* its world box */
+    float voxel;             /* its spacing, world units */
+    int has_background_grid; /* 1 when a coarse outer grid models the surroundings */
+    size_t points;           /* grid points in all grids */
+    size_t occupied_cells;   /* cells that may hold visible density */
+    size_t bytes;            /* memory the field holds */
+} vf_field_info;
+
+void vf_field_get_info(const vf_field *f, vf_field_info *info);
+
+/* ---- model files ------------------------------------------------------------------------- */
+
+/* Write the field to path (atomically): a header with magic and format version, the grids,
+ * and a checksum. */
+vf_status vf_field_save(const vf_field *f, const char *path);
+
+/* Read a field written by vf_field_save. VF_EINPUT with a clear message when the file is
+ * missing, not a field, from another format version, truncated or corrupt. */
+vf_status vf_field_load(const char *path, vf_field **out);
+
+/* Release a field; NULL is fine. */
+void vf_field_free(vf_field *f);
+
+/* ---- training ---------------------------------------------------------------------------- */
+
+typedef struct vf_field_train_options {
+    double seconds;          /* training time budget in wall-clock seconds (0: use steps) */
+    int steps;               /* number of optimizer steps when seconds is 0 */
+    int batch_rays;          /* rays per step */
+    double max_points;       /* grid points of the finest grid (about res^3) */
+    int levels;              /* coarse-to-fine levels (each 2x the points of the one before) */
+    double upsample_end;     /* fraction of the budget by which the finest level is reached */
+    float background[3];     /* colour behind transparent pixels, and of rays that see nothing */
+    int keep_background;     /* opaque photos: also fit the surroundings (coarse outer grid) */
+    float background_scale;  /* the outer grid's box is this many times the object box */
+    float box_scale;         /* object box half-size, as a fraction of the camera distance
+                                times tan(half the narrower field of view) (0: automatic) */
+    float lr_density, lr_color; /* Adam learning rates (decay 10x over the run) */
+    float tv_density, tv_color; /* total-variation weights (0: off) */
+    uint64_t seed;
+    int threads;             /* 0: all cores */
+} vf_field_train_options;
+
+/* Fill in the defaults (3 minutes, 8192 rays a step, 128^3 points, white background...). */
+void vf_field_train_defaults(vf_field_train_options *opt);
+
+typedef struct vf_field_trainer vf_field_trainer;
+
+typedef struct vf_field_train_status {
+    int step;              /* optimizer steps taken */
+    double fraction;       /* how much of the budget (time or steps) is used, 0..1 */
+    double elapsed;        /* training seconds so far (since vf_field_trainer_start) */
+    double seconds_left;   /* estimate */
+    double loss;           /* mean squared error of recent batches */
+    double psnr;           /* training PSNR of recent batches (on rays that can see the object) */
+    int level;             /* coarse-to-fine level, 0 first */
+    double samples_per_ray; /* mean samples a training ray took in the last batch */
+    double step_ms;        /* wall time of the last step: rays / optimizer */
+    double optimizer_ms;
+    double touched_points;  /* grid points the last step updated */
+    double occupied;        /* fraction of the object grid's cells that may hold density */
+    int done;              /* the budget is used up */
+} vf_field_train_status;
+
+/* Create a trainer with the given options (copied). */
+vf_status vf_field_trainer_create(const vf_field_train_options *opt, vf_field_trainer **out);
+
+/* Add one posed training image. `image` has 3 (RGB) or 4 (RGBA, straight alpha) channels and
+ * the camera's size; its pixels are copied (8 bits per channel). With alpha, pixels are
+ * composited on the background colour, and the alpha also carves the empty space around the
+ * object (visual hull). */
+vf_status vf_field_trainer_add_view(vf_field_trainer *t, const vf_camera *cam, const double c2w[16],
+                                    const vf_image *image);
+
+/* Place the scene box, carve, build the coarse grid and start the clock. */
+vf_status vf_field_trainer_start(vf_field_trainer *t);
+
+/* One optimizer step (a batch of rays). Fills status; status->done is set once the budget is
+ * used up, after which further calls do nothing. */
+vf_status vf_field_trainer_step(vf_field_trainer *t, vf_field_train_status *status);
+
+/* The field being trained (borrowed: valid until the next step or vf_field_trainer_free). */
+const vf_field *vf_field_trainer_field(const vf_field_trainer *t);
+
+/* Hand the trained field to the caller (who frees it); the trainer can only be freed after. */
+vf_field *vf_field_trainer_take_field(vf_field_trainer *t);
+
+/* Save everything needed to continue (field, optimizer state, schedule position) to path,
+ * atomically. */
+vf_status vf_field_trainer_save_checkpoint(const vf_field_trainer *t, const char *path);
+
+/* Continue from a checkpoint instead of vf_field_trainer_start(), after adding the same
+ * views. VF_EINPUT when it is corrupt, from another version, or was made with other views. */
+vf_status vf_field_trainer_resume(vf_field_trainer *t, const char *path);
+
+void vf_field_trainer_free(vf_field_trainer *t);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

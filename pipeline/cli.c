@@ -1,0 +1,80 @@
+#include "cli.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vf/log.h"
+
+int cli_common_option(int opt, cli_flags *flags, const char *command, const char *usage)
+{
+    switch (opt) {
+    case 'h':
+        fputs(usage, stdout);
+        exit(0);
+    case 'q':
+        flags->quiet = 1;
+        vf_log_set_quiet(1);
+        return 1;
+    case CLI_OPT_JSON:
+        flags->json = 1;
+        return 1;
+    case '?':
+    case ':':
+        fprintf(stderr, "vfcapture %s: see 'vfcapture %s --help'\n", command, command);
+        exit(VF_EINPUT);
+    default:
+        return 0;
+    }
+}
+
+int cli_fail(const char *command, vf_status status)
+{
+    const char *message = vf_error_message();
+    fprintf(stderr, "vfcapture %s: error: %s\n", command, message[0] ? message : "failed");
+    return (int)status;
+}
+
+void cli_print_json(json_t *doc)
+{
+    char *text = json_dumps(doc, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10));
+    if (text) {
+        puts(text);
+        free(text);
+    }
+    fflush(stdout);
+    json_decref(doc);
+}
+
+int cli_parse_doubles(const char *text, double *out, int max)
+{
+    int count = 0;
+    const char *p = text;
+    while (*p) {
+        if (count == max)
+            return -1;
+        char *end;
+        errno = 0;
+        out[count] = strtod(p, &end);
+        if (end == p || errno)
+            return -1;
+        count++;
+        p = end;
+        if (*p == ',')
+            p++;
+        else if (*p)
+            return -1;
+    }
+    return count;
+}
+
+int cli_parse_int(const char *text, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    long value = strtol(text, &end, 10);
+    if (end == text || *end || errno || value < lo || value > hi)
+        return -1;
+    *out = value;
+    return 0;
+}

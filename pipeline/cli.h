@@ -1,0 +1,58 @@
+/* pipeline/cli.h: what every stage command shares.
+ *
+ * Each command is `int cmd_<name>(int argc, char **argv)` (argv[0] is the command name) and
+ * returns the process exit code: 0 ok, 1 bad input, 2 internal failure (vf_status values).
+ * Options are getopt_long style; --help, --quiet and --json mean the same everywhere. */
+#ifndef VF_PIPELINE_CLI_H
+#define VF_PIPELINE_CLI_H
+
+#include <getopt.h>
+#include <jansson.h>
+#include <stdio.h>
+
+#include "vf/error.h"
+
+/* The long options every command accepts; put CLI_COMMON_OPTIONS first in its table. */
+enum { CLI_OPT_JSON = 1000, CLI_OPT_FIRST_CUSTOM = 1100 };
+#define CLI_COMMON_OPTIONS                                                                 \
+    {"help", no_argument, NULL, 'h'}, {"quiet", no_argument, NULL, 'q'},                   \
+        {"json", no_argument, NULL, CLI_OPT_JSON}
+#define CLI_COMMON_SHORT "hq"
+#define CLI_COMMON_HELP                                                                    \
+    "  -q, --quiet        no progress or info messages (warnings and errors still show)\n" \
+    "      --json         print the result as one JSON document on stdout\n"              \
+    "  -h, --help         show this help\n"
+
+typedef struct cli_flags {
+    int json;
+    int quiet;
+} cli_flags;
+
+typedef struct cli_command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} cli_command;
+
+/* Handle a common option. Returns 1 when `opt` was one (and applied), 0 when it is the
+ * command's own. A --help prints `usage` to stdout and exits 0; an unknown option prints a
+ * hint and exits 1. */
+int cli_common_option(int opt, cli_flags *flags, const char *command, const char *usage);
+
+/* Print "vfcapture COMMAND: error: <message>" for the current vf error and return status. */
+int cli_fail(const char *command, vf_status status);
+
+/* Print a JSON document on stdout (and take ownership of it). */
+void cli_print_json(json_t *doc);
+
+/* Parse "a,b,c" into at most max doubles; returns how many, or -1 when malformed. */
+int cli_parse_doubles(const char *text, double *out, int max);
+/* Parse a whole-string integer within [lo, hi]; returns 0 on success. */
+int cli_parse_int(const char *text, long lo, long hi, long *out);
+
+/* Commands (one file each in pipeline/). */
+int cmd_ingest(int argc, char **argv);
+int cmd_classify(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+
+#endif

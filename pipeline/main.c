@@ -1,0 +1,52 @@
+/* vfcapture: the command line. Dispatches `vfcapture <command> [options]` to one file per
+ * command in pipeline/. */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+static const cli_command commands[] = {
+    {"ingest", cmd_ingest, "bring frames into a workspace (posed dataset import)"},
+    {"classify", cmd_classify, "classify images with an ImageNet model, print top-5"},
+    {"info", cmd_info, "show a workspace's stages, parameters and outputs"},
+};
+static const int command_count = sizeof commands / sizeof commands[0];
+
+static void print_usage(FILE *out)
+{
+    fprintf(out,
+            "vfcapture %s: viewpoint attacks on image classifiers, from a capture of a real object\n"
+            "\n"
+            "usage: vfcapture <command> [options]   (vfcapture <command> --help for details)\n"
+            "\n"
+            "commands:\n",
+            VF_VERSION);
+    for (int i = 0; i < command_count; i++)
+        fprintf(out, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    fprintf(out, "\n"
+                 "Exit codes: 0 ok, 1 bad input (the message says what to fix), 2 internal failure.\n"
+                 "Models and data are found under $VF_SHARED_DIR (default: %s).\n",
+            VF_DEFAULT_SHARED_DIR);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        print_usage(stderr);
+        return 1;
+    }
+    const char *name = argv[1];
+    if (!strcmp(name, "-h") || !strcmp(name, "--help") || !strcmp(name, "help")) {
+        print_usage(stdout);
+        return 0;
+    }
+    if (!strcmp(name, "--version")) {
+        printf("vfcapture %s\n", VF_VERSION);
+        return 0;
+    }
+    for (int i = 0; i < command_count; i++)
+        if (!strcmp(name, commands[i].name))
+            return commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "vfcapture: unknown command '%s' (see 'vfcapture --help')\n", name);
+    return 1;
+}

@@ -1,0 +1,54 @@
+/* pipeline/poses.h: the poses stage's pieces, shared by cmd_poses.c (options, the flow, the
+ * outputs) and poses_colmap.c (the COLMAP steps). Private to the pipeline. */
+#ifndef VF_PIPELINE_POSES_H
+#define VF_PIPELINE_POSES_H
+
+#include <jansson.h>
+
+#include "vf/camera.h"
+#include "vf/colmap.h"
+#include "vf/colmap_model.h"
+#include "vf/sfm_images.h"
+#include "vf/workspace.h"
+
+typedef struct poses_options {
+    const char *workspace;
+    const char *matcher;      /* "auto", "sequential", "exhaustive" */
+    const char *camera_model; /* "auto" or a COLMAP model name */
+    const char *vocab_tree;   /* for sequential loop detection, or NULL */
+    int overlap;              /* sequential matching: neighbours per frame */
+    int max_features;
+    double min_registered;    /* share of frames that must register */
+    int undistort;
+    int has_intrinsics;       /* known camera: `known` holds it (size of the frames) */
+    vf_camera known;
+    const char *camera_file;  /* where `known` came from, or NULL for --intrinsics */
+} poses_options;
+
+/* One run of the stage: everything the steps share. */
+typedef struct poses_run {
+    const poses_options *opt;
+    vf_stage stage;
+    vf_colmap colmap;
+    char scratch[VF_PATH_MAX];  /* stage/.colmap: COLMAP's working files, dropped at the end */
+    char images[VF_PATH_MAX];   /* stage/images: what COLMAP reads */
+    char database[VF_PATH_MAX]; /* stage/database.db */
+    vf_sfm_images frames;
+    const char *matcher;        /* resolved */
+    const char *camera_model;   /* resolved */
+    vf_colmap_model model;      /* the largest model COLMAP made */
+    char model_dir[VF_PATH_MAX]; /* its binary files */
+    int model_count;
+    json_t *seconds;            /* wall time per step */
+} poses_run;
+
+/* COLMAP steps (poses_colmap.c); each adds its wall time to run->seconds. */
+vf_status poses_extract_features(poses_run *run);
+vf_status poses_match(poses_run *run);
+/* Map, convert every model COLMAP made to text, keep the largest in run->model and its text
+ * files in stage/sparse. No model at all leaves run->model empty (0 images). */
+vf_status poses_map(poses_run *run);
+/* Undistorted pinhole images in stage/undistorted/images and their cameras in `out`. */
+vf_status poses_undistort(poses_run *run, vf_colmap_model *out);
+
+#endif

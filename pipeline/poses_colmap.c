@@ -1,0 +1,217 @@
+/* The poses stage's COLMAP steps: the command lines, and picking the model to keep. */
+#define _GNU_SOURCE
+#include <ctype.h>
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "poses.h"
+#include "vf/log.h"
+
+/* Run one COLMAP command and record its wall time under its name (summed over repeats). */
+static vf_status run_step(poses_run *run, const char *label, vf_args *args)
+{
+    double seconds = 0;
+    vf_status status = vf_colmap_run(&run->colmap, label, (size_t)run->frames.count, args,
+                                     &seconds);
+    const char *name = args->count ? args->items[0] : "colmap";
+    json_t *before = json_object_get(run->seconds, name);
+    json_object_set_new(run->seconds, name, json_real(seconds + json_number_value(before)));
+    vf_args_free(args);
+    return status;
+}
+
+/* "fx,fy,cx,cy" (PINHOLE) or with ",k1,k2,p1,p2" (OPENCV), as ImageReader.camera_params. */
+static void known_params(const vf_camera *c, char *out, size_t size)
+{
+    int n = snprintf(out, size, "%.10g,%.10g,%.10g,%.10g", c->fx, c->fy, c->cx, c->cy);
+    if (vf_camera_has_distortion(c))
+        snprintf(out + n, size - (size_t)n, ",%.10g,%.10g,%.10g,%.10g", c->k1, c->k2, c->p1,
+                 c->p2);
+}
+
+vf_status poses_extract_features(poses_run *run)
+{
+    vf_args a = {0};
+    vf_args_add(&a, "feature_extractor");
+    vf_args_opt(&a, "--database_path", "%s", run->database);
+    vf_args_opt(&a, "--image_path", "%s", run->images);
+    vf_args_opt(&a, "--ImageReader.camera_model", "%s", run->camera_model);
+    vf_args_opt(&a, "--ImageReader.single_camera_per_folder", "1");
+    if (run->opt->has_intrinsics) {
+        char params[256];
+        known_params(&run->opt->known, params, sizeof params);
+        vf_args_opt(&a, "--ImageReader.camera_params", "%s", params);
+    } else {
+        vf_args_opt(&a, "--ImageReader.default_focal_length_factor", "1.2");
+    }
+    vf_args_opt(&a, "--SiftExtraction.use_gpu", "0");
+    vf_args_opt(&a, "--SiftExtraction.max_num_features", "%d", run->opt->max_features);
+    return run_step(run, "COLMAP: extracting features", &a);
+}
+
+vf_status poses_match(poses_run *run)
+{
+    vf_args a = {0};
+    int sequential = !strcmp(run->matcher, "sequential");
+    vf_args_add(&a, sequential ? "sequential_matcher" : "exhaustive_matcher");
+    vf_args_opt(&a, "--database_path", "%s", run->database);
+    vf_args_opt(&a, "--SiftMatching.use_gpu", "0");
+    if (sequential) {
+        vf_args_opt(&a, "--SequentialMatching.overlap", "%d", run->opt->overlap);
+        vf_args_opt(&a, "--SequentialMatching.quadratic_overlap", "1");
+        vf_args_opt(&a, "--SequentialMatching.loop_detection", "%d", run->opt->vocab_tree != NULL);
+        if (run->opt->vocab_tree)
+            vf_args_opt(&a, "--SequentialMatching.vocab_tree_path", "%s", run->opt->vocab_tree);
+    } else {
+        vf_args_opt(&a, "--ExhaustiveMatching.block_size", "10"); /* finer progress */
+    }
+    return run_step(run, sequential ? "COLMAP: matching neighbours" : "COLMAP: matching all pairs",
+                    &a);
+}
+
+static vf_status run_mapper(poses_run *run, const char *output)
+{
+    vf_args a = {0};
+    vf_args_add(&a, "mapper");
+    vf_args_opt(&a, "--database_path", "%s", run->database);
+    vf_args_opt(&a, "--image_path", "%s", run->images);
+    vf_args_opt(&a, "--output_path", "%s", output);
+    if (run->opt->has_intrinsics) {
+        vf_args_opt(&a, "--Mapper.ba_refine_focal_length", "0");
+        vf_args_opt(&a, "--Mapper.ba_refine_principal_point", "0");
+        vf_args_opt(&a, "--Mapper.ba_refine_extra_params", "0");
+    }
+    return run_step(run, "COLMAP: registering frames", &a);
+}
+
+static vf_status convert_to_text(poses_run *run, const char *input, const char *output)
+{
+    vf_status status = vf_mkdirs(output);
+    if (status != VF_OK)
+        return status;
+    vf_args a = {0};
+    vf_args_add(&a, "model_converter");
+    vf_args_opt(&a, "--input_path", "%s", input);
+    vf_args_opt(&a, "--output_path", "%s", output);
+    vf_args_opt(&a, "--output_type", "TXT");
+    return run_step(run, NULL, &a);
+}
+
+static int is_number(const char *name)
+{
+    if (!*name)
+        return 0;
+    for (; *name; name++)
+        if (!isdigit((unsigned char)*name))
+            return 0;
+    return 1;
+}
+
+/* Load model `name` (a numbered folder under sparse_dir) and keep it when it registers more
+ * images than run->model. */
+static vf_status consider_model(poses_run *run, const char *sparse_dir, const char *name)
+{
+    char bin[VF_PATH_MAX], txt[VF_PATH_MAX], txt_root[VF_PATH_MAX];
+    vf_colmap_model model;
+    vf_status status = vf_path_join(bin, sizeof bin, sparse_dir, name);
+    if (status == VF_OK)
+        status = vf_path_join(txt_root, sizeof txt_root, run->scratch, "text");
+    if (status == VF_OK)
+        status = vf_path_join(txt, sizeof txt, txt_root, name);
+    if (status == VF_OK)
+        status = convert_to_text(run, bin, txt);
+    if (status == VF_OK)
+        status = vf_colmap_model_load(txt, &model);
+    if (status != VF_OK)
+        return status;
+    run->model_count++;
+    int better = model.image_count > run->model.image_count ||
+                 (model.image_count == run->model.image_count &&
+                  model.point_count > run->model.point_count);
+    if (!better) {
+        vf_colmap_model_free(&model);
+        return VF_OK;
+    }
+    vf_colmap_model_free(&run->model);
+    run->model = model;
+    snprintf(run->model_dir, sizeof run->model_dir, "%s", bin);
+    return VF_OK;
+}
+
+/* Move the chosen model's text files to stage/sparse. */
+static vf_status keep_model_text(poses_run *run)
+{
+    char name[256], text[VF_PATH_MAX], from[VF_PATH_MAX], to[VF_PATH_MAX];
+    vf_path_basename(name, sizeof name, run->model_dir, 0);
+    vf_status status = vf_path_join(text, sizeof text, run->scratch, "text");
+    if (status == VF_OK)
+        status = vf_path_join(from, sizeof from, text, name);
+    if (status == VF_OK)
+        status = vf_path_join(to, sizeof to, run->stage.dir, "sparse");
+    if (status == VF_OK && rename(from, to) != 0)
+        status = vf_fail(VF_EINTERNAL, "cannot move %s to %s: %s", from, to, strerror(errno));
+    return status;
+}
+
+vf_status poses_map(poses_run *run)
+{
+    char sparse[VF_PATH_MAX];
+    vf_status status = vf_path_join(sparse, sizeof sparse, run->scratch, "sparse");
+    if (status == VF_OK)
+        status = vf_mkdirs(sparse);
+    if (status == VF_OK)
+        status = run_mapper(run, sparse);
+    if (status != VF_OK)
+        return status;
+    DIR *dir = opendir(sparse);
+    if (!dir)
+        return vf_fail(VF_EINTERNAL, "cannot open %s: %s", sparse, strerror(errno));
+    struct dirent *entry;
+    while (status == VF_OK && (entry = readdir(dir)))
+        if (is_number(entry->d_name))
+            status = consider_model(run, sparse, entry->d_name);
+    closedir(dir);
+    if (status == VF_OK && run->model.image_count > 0)
+        status = keep_model_text(run);
+    return status;
+}
+
+/* Drop what image_undistorter writes for dense stereo; only the images are needed. */
+static void drop_stereo_files(const char *out_dir)
+{
+    static const char *const extras[] = {"stereo", "sparse", "run-colmap-geometric.sh",
+                                         "run-colmap-photometric.sh"};
+    for (size_t i = 0; i < sizeof extras / sizeof extras[0]; i++) {
+        char path[VF_PATH_MAX];
+        if (vf_path_join(path, sizeof path, out_dir, extras[i]) == VF_OK)
+            vf_remove_tree(path);
+    }
+}
+
+vf_status poses_undistort(poses_run *run, vf_colmap_model *out)
+{
+    char out_dir[VF_PATH_MAX], sparse[VF_PATH_MAX], txt[VF_PATH_MAX];
+    vf_status status = vf_path_join(out_dir, sizeof out_dir, run->stage.dir, "undistorted");
+    if (status == VF_OK)
+        status = vf_path_join(sparse, sizeof sparse, out_dir, "sparse");
+    if (status == VF_OK)
+        status = vf_path_join(txt, sizeof txt, run->scratch, "undistorted");
+    if (status != VF_OK)
+        return status;
+    vf_args a = {0};
+    vf_args_add(&a, "image_undistorter");
+    vf_args_opt(&a, "--image_path", "%s", run->images);
+    vf_args_opt(&a, "--input_path", "%s", run->model_dir);
+    vf_args_opt(&a, "--output_path", "%s", out_dir);
+    vf_args_opt(&a, "--output_type", "COLMAP");
+    status = run_step(run, "COLMAP: undistorting", &a);
+    if (status == VF_OK)
+        status = convert_to_text(run, sparse, txt);
+    if (status == VF_OK)
+        status = vf_colmap_model_load(txt, out);
+    drop_stereo_files(out_dir);
+    return status;
+}

@@ -1,0 +1,33 @@
+#include "vf/error.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+static _Thread_local char error_text[1024];
+
+vf_status vf_fail(vf_status code, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(error_text, sizeof error_text, fmt, ap);
+    va_end(ap);
+    return code;
+}
+
+void vf_error_prefix(const char *fmt, ...)
+{
+    char old[sizeof error_text];
+    memcpy(old, error_text, sizeof old);
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(error_text, sizeof error_text, fmt, ap);
+    va_end(ap);
+    size_t used = n < 0 ? 0 : (size_t)n < sizeof error_text ? (size_t)n : sizeof error_text - 1;
+    /* "context: old message", cut at the buffer's end */
+    snprintf(error_text + used, sizeof error_text - used, ": %.1000s", old);
+}
+
+const char *vf_error_message(void) { return error_text; }
+
+void vf_error_clear(void) { error_text[0] = '\0'; }

@@ -1,0 +1,172 @@
+/* Sparse Adam over the grid points a batch touched.
+ *
+ * Every thread accumulates its rays' gradients in its own dense gradient array (no atomics)
+ * and lists the points it touched. The update then visits only those points: each point is
+ * updated once, by the lowest-numbered thread that touched it, which sums all the threads'
+ * gradients for it. Points a batch did not touch keep their moments unchanged ("lazy" Adam). */
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "trainer_internal.h"
+
+static void free_sink(field_grad_sink *s)
+{
+    for (int g = 0; g < FIELD_MAX_GRIDS; g++) {
+        free(s->grad[g]);
+        free(s->touched[g]);
+        free(s->list[g]);
+    }
+    memset(s, 0, sizeof *s);
+}
+
+void field_adam_free(field_adam *adam)
+{
+    for (int g = 0; g < FIELD_MAX_GRIDS; g++) {
+        free(adam->m[g]);
+        free(adam->v[g]);
+    }
+    for (int i = 0; adam->sinks && i < adam->threads; i++)
+        free_sink(&adam->sinks[i]);
+    free(adam->sinks);
+    memset(adam, 0, sizeof *adam);
+}
+
+vf_status field_adam_alloc(field_adam *adam, const vf_field *f, int threads)
+{
+    field_adam_free(adam);
+    adam->beta1 = 0.9f;
+    adam->beta2 = 0.99f;
+    adam->eps = 1e-8f;
+    adam->threads = threads;
+    adam->sinks = calloc((size_t)threads, sizeof *adam->sinks);
+    int ok = adam->sinks != NULL;
+    for (int g = 0; ok && g < f->grid_count; g++) {
+        size_t n = f->grids[g].points;
+        ok &= (adam->m[g] = field_alloc(n * FIELD_CH * sizeof(float))) != NULL;
+        ok &= (adam->v[g] = field_alloc(n * FIELD_CH * sizeof(float))) != NULL;
+        for (int i = 0; ok && i < threads; i++) {
+            field_grad_sink *s = &adam->sinks[i];
+            ok &= (s->grad[g] = field_alloc(n * FIELD_CH * sizeof(float))) != NULL;
+            ok &= (s->touched[g] = field_alloc(n)) != NULL;
+            ok &= (s->list[g] = malloc(n * sizeof(uint32_t))) != NULL;
+        }
+    }
+    if (!ok) {
+        field_adam_free(adam);
+        return vf_fail(VF_EINTERNAL, "out of memory for the optimizer");
+    }
+    return VF_OK;
+}
+
+size_t field_adam_touched(const field_adam *adam)
+{
+    size_t n = 0;
+    for (int g = 0; g < FIELD_MAX_GRIDS; g++)
+        for (int i = 0; i < adam->threads; i++)
+            n += adam->sinks[i].count[g];
+    return n;
+}
+
+/* Total-variation gradient at point i: the derivative of the mean over channels of
+ * sum over the 3 forward neighbour differences squared, taken at i (its 6 edges). */
+static void add_tv(const field_grid *g, size_t i, float tv_density, float tv_color,
+                   float grad[FIELD_CH])
+{
+    const size_t stride[3] = {1, (size_t)g->dim[0], (size_t)g->dim[0] * g->dim[1]};
+    int pos[3] = {(int)(i % (size_t)g->dim[0]), (int)(i / stride[1] % (size_t)g->dim[1]),
+                  (int)(i / stride[2])};
+    const float *p = g->values + i * FIELD_CH;
+    float diff[FIELD_CH] = {0};
+    for (int a = 0; a < 3; a++) {
+        if (pos[a] > 0) {
+            const float *n = p - stride[a] * FIELD_CH;
+            for (int ch = 0; ch < FIELD_CH; ch++)
+                diff[ch] += p[ch] - n[ch];
+        }
+        if (pos[a] < g->dim[a] - 1) {
+            const float *n = p + stride[a] * FIELD_CH;
+            for (int ch = 0; ch < FIELD_CH; ch++)
+                diff[ch] += p[ch] - n[ch];
+        }
+    }
+    grad[FIELD_CH_DENSITY] += 2.0f * tv_density * diff[FIELD_CH_DENSITY];
+    for (int ch = FIELD_CH_SH; ch < FIELD_CH_USED; ch++)
+        grad[ch] += 2.0f * tv_color * diff[ch];
+}
+
+/* Lowest thread whose sink touched point i of grid g. */
+static int owner(const field_adam *adam, int g, size_t i)
+{
+    for (int s = 0; s < adam->threads; s++)
+        if (adam->sinks[s].touched[g][i])
+            return s;
+    return -1;
+}
+
+static inline void adam_update(float *p, float *m, float *v, const float *grad,
+                               const float step_size[FIELD_CH], float beta1, float beta2,
+                               float eps_hat)
+{
+    for (int ch = 0; ch < FIELD_CH; ch++) {
+        m[ch] = beta1 * m[ch] + (1.0f - beta1) * grad[ch];
+        v[ch] = beta2 * v[ch] + (1.0f - beta2) * grad[ch] * grad[ch];
+        p[ch] -= step_size[ch] * m[ch] / (__builtin_sqrtf(v[ch]) + eps_hat);
+    }
+}
+
+void field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
+                     float tv_color)
+{
+    adam->t++;
+    const float bc1 = 1.0f - powf(adam->beta1, (float)adam->t);
+    const float bc2 = 1.0f - powf(adam->beta2, (float)adam->t);
+    /* Adam with bias correction folded into the step size and epsilon. */
+    float step_size[FIELD_CH];
+    for (int ch = 0; ch < FIELD_CH; ch++)
+        step_size[ch] = lr[ch] * sqrtf(bc2) / bc1;
+    const float eps_hat = adam->eps * sqrtf(bc2);
+    const int use_tv = tv_density > 0 || tv_color > 0;
+    const int threads = adam->threads;
+
+#pragma omp parallel num_threads(threads)
+    {
+        const int me = omp_get_thread_num();
+        field_grad_sink *mine = &adam->sinks[me];
+        for (int g = 0; g < f->grid_count; g++) {
+            field_grid *grid = &f->grids[g];
+            /* 1. the owner of each point gathers its total gradient into its own sink */
+            for (size_t k = 0; k < mine->count[g]; k++) {
+                size_t i = mine->list[g][k];
+                if (owner(adam, g, i) != me)
+                    continue;
+                float *total = mine->grad[g] + i * FIELD_CH;
+                for (int s = me + 1; s < threads; s++)
+                    if (adam->sinks[s].touched[g][i]) {
+                        const float *other = adam->sinks[s].grad[g] + i * FIELD_CH;
+                        for (int ch = 0; ch < FIELD_CH; ch++)
+                            total[ch] += other[ch];
+                    }
+                if (use_tv)
+                    add_tv(grid, i, tv_density, tv_color, total);
+            }
+#pragma omp barrier
+            /* 2. update the points it owns; clear everything it touched */
+            for (size_t k = 0; k < mine->count[g]; k++) {
+                size_t i = mine->list[g][k];
+                float *grad = mine->grad[g] + i * FIELD_CH;
+                if (owner(adam, g, i) == me)
+                    adam_update(grid->values + i * FIELD_CH, adam->m[g] + i * FIELD_CH,
+                                adam->v[g] + i * FIELD_CH, grad, step_size, adam->beta1,
+                                adam->beta2, eps_hat);
+            }
+#pragma omp barrier
+            for (size_t k = 0; k < mine->count[g]; k++) {
+                size_t i = mine->list[g][k];
+                memset(mine->grad[g] + i * FIELD_CH, 0, FIELD_CH * sizeof(float));
+                mine->touched[g][i] = 0;
+            }
+            mine->count[g] = 0;
+        }
+    }
+}

@@ -1,0 +1,173 @@
+/* src/field/field_internal.h: the radiance-field engine's internals, shared by the src/field sources
+ * and the unit tests (not part of the public API in vf/field.h).
+ *
+ * The model is an explicit voxel grid (DVGO-style density, Plenoxels-style colour):
+ *
+ *   - grid points on a regular lattice over an axis-aligned box, FIELD_CH floats per point:
+ *     channel 0 is the raw density d, channels 1..12 the degree-1 spherical-harmonics colour
+ *     logits (colour k, basis b at 1 + 4k + b with basis (1, x, y, z) of the unit view
+ *     direction), channels 13..15 are padding so that one point is one 64-byte cache line;
+ *   - values between points are trilinear; density sigma = softplus(d + shift) * scale per
+ *     world unit; colour = sigmoid(SH logits . basis(direction));
+ *   - a ray is sampled every `step` world units; sample i gets alpha_i = 1 - exp(-sigma_i step)
+ *     and the usual front-to-back compositing C = sum T_i alpha_i c_i + T_end * background;
+ *   - an occupancy bitfield (one bit per cell, one byte per 8^3-cell block) says where density
+ *     may be visible; the march jumps over empty blocks and skips empty cells, and stops when
+ *     the transmittance T falls below a threshold (early termination).
+ *
+ * A field may have a second, coarser grid around the first (the background of a real scene);
+ * a ray then marches the outer grid up to the inner box, the inner grid inside it, and the
+ * outer grid again behind it. */
+#ifndef VF_FIELD_INTERNAL_H
+#define VF_FIELD_INTERNAL_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "vf/camera.h"
+#include "vf/field.h"
+
+#define FIELD_CH 16         /* floats per grid point */
+#define FIELD_CH_USED 13    /* density + 12 SH coefficients */
+#define FIELD_CH_DENSITY 0
+#define FIELD_CH_SH 1       /* colour k, SH basis b: FIELD_CH_SH + 4 * k + b */
+#define FIELD_BLOCK_SHIFT 3 /* occupancy blocks are 8^3 cells */
+#define FIELD_MAX_GRIDS 2
+#define FIELD_EMPTY_DENSITY (-30.0f) /* raw density of carved-away space */
+
+typedef struct field_grid {
+    int dim[3];        /* grid points along x, y, z */
+    float lo[3];       /* world position of point (0, 0, 0) */
+    float hi[3];       /* world position of the last point */
+    float voxel;       /* spacing between points, the same on every axis */
+    size_t points;     /* dim[0] * dim[1] * dim[2] */
+    float *values;     /* points * FIELD_CH floats, 64-byte aligned */
+    int cells[3];      /* dim - 1: the trilinear cells */
+    uint64_t *cell_bits; /* one bit per cell: 1 when the cell may hold visible density */
+    int blocks[3];     /* ceil(cells / 8) */
+    uint8_t *block_bits; /* one byte per block: 1 when any of its cells is occupied */
+} field_grid;
+
+/* The model behind the public vf_field handle. */
+struct vf_field {
+    int grid_count;                    /* 1, or 2 with an outer (background) grid */
+    field_grid grids[FIELD_MAX_GRIDS]; /* grids[0] is the object; grids[1] surrounds it */
+    float density_shift;   /* sigma = softplus(d + density_shift) * density_scale */
+    float density_scale;
+    float step_ratio;      /* sample spacing in voxels of the grid being marched */
+    float background[3];   /* colour of rays that leave the field */
+    float occupancy_alpha; /* a cell is empty when no corner reaches this alpha per step */
+    float stop_transmittance; /* rendering stops a ray below this transmittance */
+    vf_camera camera;      /* a reference training camera (intrinsics) */
+    double scene_center[3]; /* the point the cameras look at */
+    double camera_distance; /* their mean distance to it */
+};
+
+/* ---- grid.c: storage, trilinear resampling, occupancy -------------------------------- */
+
+/* Allocate a grid of dim points from lo with the given spacing; values zeroed, occupancy all
+ * set. */
+vf_status field_grid_alloc(field_grid *g, const int dim[3], const float lo[3], float voxel);
+void field_grid_free(field_grid *g);
+
+/* Memory for big arrays: 64-byte aligned, zeroed, huge pages where the kernel offers them.
+ * Release with free(). NULL when out of memory. */
+void *field_alloc(size_t bytes);
+
+/* Make `out` a grid over (at least) the same box with the new spacing, its values the
+ * trilinear resampling of `src`. */
+vf_status field_grid_resample(const field_grid *src, float voxel, field_grid *out);
+
+/* Recompute the occupancy of a grid from its densities: a cell is occupied when one of its
+ * corners has alpha >= threshold for a step of step_world. */
+void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_world);
+
+/* Set all occupancy bits (used before the densities mean anything). */
+void field_grid_fill_occupancy(field_grid *g);
+
+/* Number of occupied cells. */
+size_t field_grid_occupied_cells(const field_grid *g);
+
+static inline int field_cell_occupied(const field_grid *g, size_t cell)
+{
+    return (int)((g->cell_bits[cell >> 6] >> (cell & 63)) & 1u);
+}
+
+/* ---- march.c: one ray, forward and backward -------------------------------------------- */
+
+typedef struct field_ray {
+    float origin[3];
+    float dir[3]; /* unit length */
+    float tmin, tmax;
+} field_ray;
+
+/* What the backward pass needs of one sample. */
+typedef struct field_sample {
+    uint32_t base;    /* index of the cell's lowest corner point */
+    uint8_t grid;     /* which grid */
+    float frac[3];    /* position inside the cell, 0..1 per axis */
+    float alpha;      /* opacity of the sample's step */
+    float trans;      /* transmittance in front of the sample */
+    float rgb[3];     /* colour */
+    float dtau;       /* d(sigma * step) / d(raw density) */
+} field_sample;
+
+/* Scratch of one thread: sample records for the backward pass. */
+typedef struct field_scratch {
+    field_sample *samples;
+    int capacity;
+} field_scratch;
+
+typedef struct field_march_result {
+    float rgb[3];      /* composited colour, background included */
+    float trans;       /* transmittance left at the end (weight of the background) */
+    float depth;       /* expected ray distance of the surface (weighted by alpha) */
+    int count;         /* samples recorded (or taken, when not recording) */
+    int overflow;      /* 1 when the scratch was too small and the ray was cut short */
+} field_march_result;
+
+/* The largest number of samples a ray can take in the field. */
+int field_max_samples(const vf_field *f);
+
+/* March one ray front to back. jitter (0..1) offsets the first sample within its step;
+ * min_trans ends the ray early. With `rec` the samples are recorded for field_backward(). */
+void field_march(const vf_field *f, const field_ray *ray, float jitter, float min_trans,
+                 field_scratch *rec, field_march_result *out);
+
+/* Where the gradient of one thread goes: dense per-grid gradient arrays the size of the values,
+ * plus a list of the points touched since the last optimizer step (flag per point). */
+typedef struct field_grad_sink {
+    float *grad[FIELD_MAX_GRIDS];
+    uint8_t *touched[FIELD_MAX_GRIDS];
+    uint32_t *list[FIELD_MAX_GRIDS];
+    size_t count[FIELD_MAX_GRIDS];
+} field_grad_sink;
+
+/* Accumulate dL/dvalues for one marched ray, given dL/drgb of its composited colour, into
+ * the sink. `res` is the forward result of the same ray. */
+void field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
+                    const field_march_result *res, const float dl_drgb[3], field_grad_sink *sink);
+
+/* Clip a ray to a box; returns 0 when it misses. */
+int field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], float *t0, float *t1);
+
+/* ---- render.c: rays of a camera ------------------------------------------------------- */
+
+/* World-space ray through pixel centre (x + 0.5, y + 0.5) of a camera with camera-to-world
+ * c2w (row-major, OpenGL axes). `unit_xy` is the undistorted normalized image point of the
+ * pixel in OpenCV axes (x right, y down) or NULL for a pinhole computed from the camera. */
+void field_camera_ray(const vf_camera *cam, const double c2w[16], double x, double y,
+                      field_ray *ray);
+
+static inline float field_softplus(float x)
+{
+    return x > 20.0f ? x : log1pf(expf(x));
+}
+
+static inline float field_sigmoid(float x)
+{
+    return 1.0f / (1.0f + expf(-x));
+}
+
+#endif

@@ -1,0 +1,191 @@
+/* Rendering whole images from a field: one ray per pixel, rows spread over the cores. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "field_internal.h"
+
+void field_camera_ray(const vf_camera *cam, const double c2w[16], double x, double y,
+                      field_ray *ray)
+{
+    double d_cv[3]; /* OpenCV camera axes: x right, y down, z forward */
+    if (vf_camera_has_distortion(cam)) {
+        vf_camera_pixel_ray(cam, x, y, d_cv);
+    } else {
+        d_cv[0] = (x - cam->cx) / cam->fx;
+        d_cv[1] = (y - cam->cy) / cam->fy;
+        d_cv[2] = 1.0;
+    }
+    const double d_gl[3] = {d_cv[0], -d_cv[1], -d_cv[2]}; /* to OpenGL axes */
+    double w[3], norm = 0;
+    for (int r = 0; r < 3; r++) {
+        w[r] = c2w[4 * r] * d_gl[0] + c2w[4 * r + 1] * d_gl[1] + c2w[4 * r + 2] * d_gl[2];
+        norm += w[r] * w[r];
+    }
+    norm = sqrt(norm);
+    for (int r = 0; r < 3; r++) {
+        ray->origin[r] = (float)c2w[4 * r + 3];
+        ray->dir[r] = (float)(w[r] / norm);
+    }
+    ray->tmin = 0.0f;
+    ray->tmax = 1e30f;
+}
+
+static vf_status ensure_image(vf_image *img, int width, int height, int channels)
+{
+    if (img->data && img->width == width && img->height == height && img->channels == channels)
+        return VF_OK;
+    vf_image_free(img);
+    return vf_image_alloc(img, width, height, channels);
+}
+
+static vf_status check_camera(const vf_camera *cam)
+{
+    if (cam->width < 1 || cam->height < 1 || cam->width > 16384 || cam->height > 16384 ||
+        !(cam->fx > 0) || !(cam->fy > 0))
+        return vf_fail(VF_EINPUT, "cannot render with a %dx%d camera of focal length %g", cam->width,
+                       cam->height, cam->fx);
+    return VF_OK;
+}
+
+/* Render one image into rgb (3 floats a pixel), depth and opacity (1 float a pixel; may be
+ * NULL). Runs in the calling thread; `parallel` spreads rows over the cores. */
+static void render_rows(const vf_field *f, const vf_camera *cam, const double c2w[16], float *rgb,
+                        float *depth, float *opacity, int parallel)
+{
+    const int width = cam->width, height = cam->height;
+#pragma omp parallel for schedule(dynamic, 2) if (parallel)
+    for (int y = 0; y < height; y++) {
+        for (int x = 0; x < width; x++) {
+            field_ray ray;
+            field_march_result res;
+            field_camera_ray(cam, c2w, x + 0.5, y + 0.5, &ray);
+            field_march(f, &ray, 0.5f, f->stop_transmittance, NULL, &res);
+            size_t i = (size_t)y * width + x;
+            if (rgb)
+                memcpy(rgb + 3 * i, res.rgb, sizeof res.rgb);
+            float opaque = 1.0f - res.trans;
+            if (depth)
+                depth[i] = opaque > 1e-4f ? res.depth / opaque : 0.0f;
+            if (opacity)
+                opacity[i] = opaque;
+        }
+    }
+}
+
+vf_status vf_field_render(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                          vf_image *out)
+{
+    vf_status status = check_camera(cam);
+    if (status == VF_OK)
+        status = ensure_image(out, cam->width, cam->height, 3);
+    if (status == VF_OK)
+        render_rows(f, cam, c2w, out->data, NULL, NULL, 1);
+    return status;
+}
+
+vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const double *c2w, int n,
+                                vf_image *out)
+{
+    vf_status status = check_camera(cam);
+    for (int i = 0; status == VF_OK && i < n; i++)
+        status = ensure_image(&out[i], cam->width, cam->height, 3);
+    if (status != VF_OK)
+        return status;
+    /* Small images: one image per thread keeps each core on its own memory; otherwise split
+     * every image's rows. */
+    if ((size_t)cam->width * cam->height <= 512 * 512 && n > 1) {
+#pragma omp parallel for schedule(dynamic, 1)
+        for (int i = 0; i < n; i++)
+            render_rows(f, cam, c2w + 16 * i, out[i].data, NULL, NULL, 0);
+    } else {
+        for (int i = 0; i < n; i++)
+            render_rows(f, cam, c2w + 16 * i, out[i].data, NULL, NULL, 1);
+    }
+    return VF_OK;
+}
+
+vf_status vf_field_render_viewpoints(const vf_field *f, const vf_camera *cam,
+                                     const vf_viewpoint *viewpoints, int n, vf_image *out)
+{
+    enum { CHUNK = 64 }; /* matrices on the stack, a chunk at a time */
+    double c2w[CHUNK * 16];
+    vf_status status = VF_OK;
+    for (int start = 0; status == VF_OK && start < n; start += CHUNK) {
+        int count = n - start < CHUNK ? n - start : CHUNK;
+        for (int i = 0; i < count; i++)
+            vf_viewpoint_to_c2w(&viewpoints[start + i], c2w + 16 * i);
+        status = vf_field_render_batch(f, cam, c2w, count, out + start);
+    }
+    return status;
+}
+
+vf_status vf_field_render_depth(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                                vf_image *depth, vf_image *opacity)
+{
+    vf_status status = check_camera(cam);
+    if (status == VF_OK && depth)
+        status = ensure_image(depth, cam->width, cam->height, 1);
+    if (status == VF_OK && opacity)
+        status = ensure_image(opacity, cam->width, cam->height, 1);
+    if (status == VF_OK)
+        render_rows(f, cam, c2w, NULL, depth ? depth->data : NULL, opacity ? opacity->data : NULL,
+                    1);
+    return status;
+}
+
+vf_camera vf_field_classifier_camera(const vf_field *f, int size)
+{
+    const vf_camera *ref = &f->camera;
+    int shorter = ref->width < ref->height ? ref->width : ref->height;
+    double resized = floor(size * 256.0 / 224.0 + 0.5); /* the shorter side after resizing */
+    double scale = resized / shorter;
+    vf_camera cam = {0};
+    cam.width = cam.height = size;
+    cam.fx = ref->fx * scale;
+    cam.fy = ref->fy * scale;
+    cam.cx = cam.cy = 0.5 * size;
+    return cam;
+}
+
+vf_camera vf_field_training_camera(const vf_field *f)
+{
+    return f->camera;
+}
+
+void vf_field_background(const vf_field *f, float rgb[3])
+{
+    memcpy(rgb, f->background, 3 * sizeof(float));
+}
+
+void vf_field_set_background(vf_field *f, const float rgb[3])
+{
+    memcpy(f->background, rgb, 3 * sizeof(float));
+}
+
+void vf_field_get_info(const vf_field *f, vf_field_info *info)
+{
+    memset(info, 0, sizeof *info);
+    const field_grid *g = &f->grids[0];
+    memcpy(info->dim, g->dim, sizeof info->dim);
+    memcpy(info->box_lo, g->lo, sizeof info->box_lo);
+    memcpy(info->box_hi, g->hi, sizeof info->box_hi);
+    info->voxel = g->voxel;
+    info->has_background_grid = f->grid_count > 1;
+    for (int i = 0; i < f->grid_count; i++) {
+        const field_grid *gi = &f->grids[i];
+        size_t cells = (size_t)gi->cells[0] * gi->cells[1] * gi->cells[2];
+        info->points += gi->points;
+        info->occupied_cells += field_grid_occupied_cells(gi);
+        info->bytes += gi->points * FIELD_CH * sizeof(float) + cells / 8 +
+                       (size_t)gi->blocks[0] * gi->blocks[1] * gi->blocks[2];
+    }
+}
+
+void vf_field_free(vf_field *f)
+{
+    if (!f)
+        return;
+    for (int i = 0; i < f->grid_count; i++)
+        field_grid_free(&f->grids[i]);
+    free(f);
+}

@@ -1,0 +1,327 @@
+/* The training loop: random batches of rays from every training pixel, forward and backward
+ * through the grids, sparse Adam; coarse-to-fine upsampling and occupancy refreshes on a
+ * schedule that follows the fraction of the budget (time or steps) used so far. */
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "trainer_internal.h"
+#include "vf/log.h"
+
+#define OCCUPANCY_EVERY 32 /* steps between occupancy refreshes */
+
+void vf_field_train_defaults(vf_field_train_options *opt)
+{
+    memset(opt, 0, sizeof *opt);
+    opt->seconds = 180;
+    opt->steps = 0;
+    opt->batch_rays = 8192;
+    opt->max_points = 128.0 * 128.0 * 128.0;
+    opt->levels = 3;
+    opt->upsample_end = 0.3;
+    opt->background[0] = opt->background[1] = opt->background[2] = 1.0f;
+    opt->keep_background = 0;
+    opt->background_scale = 4.0f;
+    opt->box_scale = 0;
+    opt->lr_density = 0.1f;
+    opt->lr_color = 0.05f;
+    opt->tv_density = 0;
+    opt->tv_color = 0;
+    opt->seed = 1;
+    opt->threads = 0;
+}
+
+static vf_status check_options(const vf_field_train_options *o)
+{
+    if (!(o->seconds > 0) && o->steps <= 0)
+        return vf_fail(VF_EINPUT, "give a training time (seconds > 0) or a number of steps");
+    if (o->batch_rays < 64 || o->batch_rays > (1 << 22))
+        return vf_fail(VF_EINPUT, "batch of %d rays is out of range", o->batch_rays);
+    if (!(o->max_points >= 1000) || o->max_points > 1e9)
+        return vf_fail(VF_EINPUT, "grid of %g points is out of range", o->max_points);
+    if (o->levels < 1 || o->levels > 8)
+        return vf_fail(VF_EINPUT, "levels must be 1..8");
+    return VF_OK;
+}
+
+vf_status vf_field_trainer_create(const vf_field_train_options *opt, vf_field_trainer **out)
+{
+    *out = NULL;
+    vf_status status = check_options(opt);
+    if (status != VF_OK)
+        return status;
+    vf_field_trainer *t = calloc(1, sizeof *t);
+    if (!t)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    t->opt = *opt;
+    t->threads = opt->threads > 0 ? opt->threads : omp_get_max_threads();
+    vf_rng_seed(&t->rng, opt->seed);
+    *out = t;
+    return VF_OK;
+}
+
+void vf_field_trainer_free(vf_field_trainer *t)
+{
+    if (!t)
+        return;
+    trainer_views_free(t);
+    field_adam_free(&t->adam);
+    for (int i = 0; t->scratch && i < t->threads; i++)
+        free(t->scratch[i].samples);
+    free(t->scratch);
+    vf_field_free(t->field);
+    free(t);
+}
+
+const vf_field *vf_field_trainer_field(const vf_field_trainer *t)
+{
+    return t->field;
+}
+
+vf_field *vf_field_trainer_take_field(vf_field_trainer *t)
+{
+    vf_field *f = t->field;
+    t->field = NULL;
+    t->done = 1;
+    return f;
+}
+
+/* (Re)size every thread's sample records for the current grids. */
+static vf_status alloc_scratch(vf_field_trainer *t)
+{
+    if (!t->scratch && !(t->scratch = calloc((size_t)t->threads, sizeof *t->scratch)))
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    int capacity = field_max_samples(t->field);
+    for (int i = 0; i < t->threads; i++) {
+        free(t->scratch[i].samples);
+        t->scratch[i].samples = malloc((size_t)capacity * sizeof(field_sample));
+        t->scratch[i].capacity = capacity;
+        if (!t->scratch[i].samples)
+            return vf_fail(VF_EINTERNAL, "out of memory");
+    }
+    return VF_OK;
+}
+
+/* Everything that depends on the grid sizes: occupancy, optimizer state, scratch. */
+static vf_status prepare_level(vf_field_trainer *t)
+{
+    vf_field *f = t->field;
+    for (int i = 0; i < f->grid_count; i++)
+        field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
+    vf_status status = field_adam_alloc(&t->adam, f, t->threads);
+    if (status == VF_OK)
+        status = alloc_scratch(t);
+    return status;
+}
+
+vf_status vf_field_trainer_start(vf_field_trainer *t)
+{
+    if (t->started)
+        return vf_fail(VF_EINTERNAL, "training already started");
+    if (t->view_count == 0)
+        return vf_fail(VF_EINPUT, "no training views");
+    t->started = 1;
+    t->start_time = vf_now();
+    vf_status status = trainer_build_grid(t);
+    if (status == VF_OK)
+        status = trainer_build_pool(t);
+    if (status == VF_OK)
+        status = prepare_level(t);
+    return status;
+}
+
+vf_status vf_field_trainer_resume(vf_field_trainer *t, const char *path)
+{
+    if (t->started)
+        return vf_fail(VF_EINTERNAL, "training already started");
+    if (t->view_count == 0)
+        return vf_fail(VF_EINPUT, "no training views");
+    vf_status status = trainer_checkpoint_read(t, path);
+    if (status == VF_OK)
+        status = trainer_build_pool(t);
+    if (status == VF_OK)
+        status = alloc_scratch(t);
+    if (status != VF_OK)
+        return status;
+    t->started = 1;
+    t->start_time = vf_now();
+    return VF_OK;
+}
+
+static double elapsed(const vf_field_trainer *t)
+{
+    return t->elapsed_before + (vf_now() - t->start_time);
+}
+
+static double budget_fraction(const vf_field_trainer *t)
+{
+    if (t->opt.seconds > 0)
+        return elapsed(t) / t->opt.seconds;
+    return (double)t->step / t->opt.steps;
+}
+
+/* The coarse-to-fine level for a budget fraction: evenly spaced up to upsample_end. */
+static int level_at(const vf_field_trainer *t, double fraction)
+{
+    int last = t->opt.levels - 1;
+    if (last == 0 || fraction >= t->opt.upsample_end)
+        return last;
+    int level = (int)(fraction / t->opt.upsample_end * last) + 0;
+    return level > last ? last : level;
+}
+
+/* Go one level finer: resample every grid at 2^(1/3) times smaller spacing. */
+static vf_status upsample(vf_field_trainer *t)
+{
+    vf_field *f = t->field;
+    t->level++;
+    double factor = pow(2.0, (t->opt.levels - 1 - t->level) / 3.0);
+    for (int i = 0; i < f->grid_count; i++) {
+        field_grid finer;
+        /* the outer grid keeps its ratio to the inner one */
+        float level_voxel = (float)(i == 0 ? t->final_voxel * factor
+                                           : f->grids[i].voxel / pow(2.0, 1.0 / 3.0));
+        vf_status status = field_grid_resample(&f->grids[i], level_voxel, &finer);
+        if (status != VF_OK)
+            return status;
+        field_grid_free(&f->grids[i]);
+        f->grids[i] = finer;
+    }
+    field_adam_free(&t->adam);
+    return prepare_level(t);
+}
+
+/* A batch of about n training pixels: random tiles (drawn with replacement) expanded to their
+ * pixels, and each ray's random offset of its first sample. Returns the number of rays. */
+static int draw_batch(vf_field_trainer *t, uint32_t *pixels, float *jitter, int n)
+{
+    int count = 0;
+    while (count + TRAIN_TILE * TRAIN_TILE <= n) {
+        uint32_t corner = t->pool[vf_rng_below(&t->rng, t->pool_size)];
+        const train_view *v = &t->views[trainer_pixel_view(t, corner)];
+        const int w = v->camera.width, h = v->camera.height;
+        size_t local = corner - v->first_pixel;
+        int x0 = (int)(local % (size_t)w), y0 = (int)(local / (size_t)w);
+        for (int y = y0; y < y0 + TRAIN_TILE && y < h; y++)
+            for (int x = x0; x < x0 + TRAIN_TILE && x < w; x++) {
+                pixels[count] = (uint32_t)(v->first_pixel + (size_t)y * w + x);
+                jitter[count++] = (float)vf_rng_uniform(&t->rng);
+            }
+    }
+    return count;
+}
+
+/* Forward and backward over a batch; returns the summed squared error. */
+static double run_batch(vf_field_trainer *t, const uint32_t *pixels, const float *jitter, int n,
+                        long *samples)
+{
+    long total = 0;
+    const vf_field *f = t->field;
+    /* d(squared error summed over the batch)/d(colour): Adam does not care about the scale,
+     * and per-ray sums keep the gradients well above its epsilon */
+    const float loss_scale = 2.0f / 3.0f;
+    double sse = 0;
+#pragma omp parallel for num_threads(t->threads) schedule(dynamic, TRAIN_TILE * TRAIN_TILE) reduction(+ : sse, total)
+    for (int i = 0; i < n; i++) {
+        const int me = omp_get_thread_num();
+        field_ray ray;
+        float target[3];
+        field_march_result res;
+        trainer_pixel_ray(t, pixels[i], &ray, target);
+        field_march(f, &ray, jitter[i], 1e-4f, &t->scratch[me], &res);
+        float dl[3];
+        for (int k = 0; k < 3; k++) {
+            float err = res.rgb[k] - target[k];
+            sse += (double)err * err;
+            dl[k] = loss_scale * err;
+        }
+        if (res.count)
+            field_backward(f, &ray, &t->scratch[me], &res, dl, &t->adam.sinks[me]);
+        total += res.count;
+    }
+    *samples = total;
+    return sse;
+}
+
+static void fill_status(const vf_field_trainer *t, vf_field_train_status *s)
+{
+    memset(s, 0, sizeof *s);
+    s->step = t->step;
+    s->fraction = fmin(budget_fraction(t), 1.0);
+    s->elapsed = elapsed(t);
+    if (t->opt.seconds > 0)
+        s->seconds_left = fmax(0.0, t->opt.seconds - s->elapsed);
+    else
+        s->seconds_left = t->step > 0 ? s->elapsed / t->step * (t->opt.steps - t->step) : 0;
+    s->loss = t->loss_avg;
+    s->psnr = t->loss_avg > 0 ? -10.0 * log10(t->loss_avg) : 0;
+    s->level = t->level;
+    s->samples_per_ray = t->last_samples_per_ray;
+    s->step_ms = t->last_step_ms;
+    s->optimizer_ms = t->last_optimizer_ms;
+    s->touched_points = t->last_touched;
+    if (t->field) {
+        const field_grid *g = &t->field->grids[0];
+        s->occupied = (double)field_grid_occupied_cells(g) /
+                      ((double)g->cells[0] * g->cells[1] * g->cells[2]);
+    }
+    s->done = t->done;
+}
+
+vf_status vf_field_trainer_step(vf_field_trainer *t, vf_field_train_status *status)
+{
+    if (!t->started || !t->field)
+        return vf_fail(VF_EINTERNAL, "training has not started");
+    double fraction = budget_fraction(t);
+    if (t->done || fraction >= 1.0) {
+        t->done = 1;
+        fill_status(t, status);
+        return VF_OK;
+    }
+    vf_status st = VF_OK;
+    while (st == VF_OK && t->level < level_at(t, fraction))
+        st = upsample(t);
+    if (st != VF_OK)
+        return st;
+    vf_field *f = t->field;
+    if (t->step % OCCUPANCY_EVERY == 0 && t->step > 0)
+        for (int i = 0; i < f->grid_count; i++)
+            field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
+
+    const int n = t->opt.batch_rays;
+    uint32_t *pixels = malloc((size_t)n * sizeof *pixels);
+    float *jitter = malloc((size_t)n * sizeof *jitter);
+    if (!pixels || !jitter) {
+        free(pixels);
+        free(jitter);
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    }
+    double t0 = vf_now();
+    int rays = draw_batch(t, pixels, jitter, n);
+    long samples = 0;
+    double mse = run_batch(t, pixels, jitter, rays, &samples) / (3.0 * rays);
+    double t1 = vf_now();
+    free(pixels);
+    free(jitter);
+
+    /* learning rates decay exponentially to a tenth over the budget */
+    float decay = (float)pow(0.1, fraction);
+    float lr[FIELD_CH] = {0};
+    lr[FIELD_CH_DENSITY] = t->opt.lr_density * decay;
+    for (int ch = FIELD_CH_SH; ch < FIELD_CH_USED; ch++)
+        lr[ch] = t->opt.lr_color * decay;
+    t->last_touched = (double)field_adam_touched(&t->adam);
+    field_adam_step(&t->adam, f, lr, t->opt.tv_density, t->opt.tv_color);
+    t->last_samples_per_ray = (double)samples / rays;
+    t->last_step_ms = (t1 - t0) * 1000;
+    t->last_optimizer_ms = (vf_now() - t1) * 1000;
+
+    t->step++;
+    /* running mean over about the last 50 steps */
+    t->loss_count = t->loss_count < 50 ? t->loss_count + 1 : 50;
+    t->loss_avg += (mse - t->loss_avg) / t->loss_count;
+    if (budget_fraction(t) >= 1.0)
+        t->done = 1;
+    fill_status(t, status);
+    return VF_OK;
+}

@@ -1,0 +1,119 @@
+/* src/field/trainer_internal.h: the training state shared by train.c (the loop),
+ * train_views.c (the photos as rays), carve.c (scene box, visual hull), adam.c (optimizer)
+ * and model_io.c (checkpoints). */
+#ifndef VF_FIELD_TRAINER_INTERNAL_H
+#define VF_FIELD_TRAINER_INTERNAL_H
+
+#include "field_internal.h"
+#include "vf/rng.h"
+
+/* Training rays come in square tiles of pixels: neighbouring rays meet the same grid points,
+ * so a thread marching a tile finds them in its cache. */
+#define TRAIN_TILE 4
+
+/* Undistorted normalized image coordinates (OpenCV axes) of every pixel centre of a camera,
+ * shared by the views that use the same camera. */
+typedef struct ray_table {
+    vf_camera camera;
+    float *xy; /* 2 floats a pixel */
+} ray_table;
+
+typedef struct train_view {
+    vf_camera camera;
+    double c2w[16];
+    size_t first_pixel; /* index of its pixel (0, 0) in the trainer's pixel arrays */
+    int table;          /* its ray table */
+    uint8_t *mask;      /* alpha > 0 (1 byte a pixel); NULL for opaque photos */
+} train_view;
+
+/* Adam state for every grid, and each thread's gradient sink. */
+typedef struct field_adam {
+    float *m[FIELD_MAX_GRIDS], *v[FIELD_MAX_GRIDS];
+    int t; /* steps since the moments were reset */
+    float beta1, beta2, eps;
+    int threads;
+    field_grad_sink *sinks; /* one per thread */
+} field_adam;
+
+struct vf_field_trainer {
+    vf_field_train_options opt;
+    int threads;
+
+    /* the photos */
+    train_view *views;
+    int view_count, view_capacity;
+    uint8_t *rgb; /* 3 bytes a pixel, background composited */
+    size_t pixels, pixel_capacity;
+    ray_table *tables;
+    int table_count;
+    int has_alpha; /* any view came with alpha: carve with it, train on rays near the hull */
+    uint32_t *pool; /* top-left pixels of the tiles worth training on */
+    size_t pool_size;
+
+    /* the model and its optimizer */
+    vf_field *field;
+    field_adam adam;
+    field_scratch *scratch; /* one per thread */
+    int level;
+    float final_voxel;
+    vf_rng rng;
+
+    /* progress */
+    int started, done;
+    int step;
+    double start_time;     /* vf_now() at start (or resume) */
+    double elapsed_before; /* training seconds of the run a checkpoint continued */
+    double loss_avg;       /* running mean of recent batch losses */
+    int loss_count;
+    double last_samples_per_ray, last_step_ms, last_optimizer_ms, last_touched;
+};
+
+/* ---- train_views.c -------------------------------------------------------------------- */
+
+/* The ray through pixel `p` (global pixel index) and its target colour. */
+void trainer_pixel_ray(const vf_field_trainer *t, size_t p, field_ray *ray, float rgb[3]);
+
+/* Which view a global pixel index belongs to. */
+int trainer_pixel_view(const vf_field_trainer *t, size_t p);
+
+/* A fingerprint of the views (sizes, cameras, poses, pixels) so a checkpoint can tell it is
+ * resumed on the same data. */
+uint64_t trainer_views_fingerprint(const vf_field_trainer *t);
+
+void trainer_views_free(vf_field_trainer *t);
+
+/* ---- carve.c ------------------------------------------------------------------------- */
+
+/* Where the cameras look (the point nearest all optical axes) and their mean distance to it. */
+void trainer_scene_center(const vf_field_trainer *t, double center[3], double *distance);
+
+/* Build the object grid: place the box, carve it with the views' alpha masks (visual hull),
+ * shrink the box to what is left, and fill the grid at the coarsest level. */
+vf_status trainer_build_grid(vf_field_trainer *t);
+
+/* The pixels whose rays pass through occupied space (for views with alpha); all pixels of
+ * opaque views. */
+vf_status trainer_build_pool(vf_field_trainer *t);
+
+/* ---- model_io.c ---------------------------------------------------------------------- */
+
+/* Load a checkpoint's field, optimizer state and schedule position into t (views already
+ * added; pool and scratch are left to the caller). */
+vf_status trainer_checkpoint_read(vf_field_trainer *t, const char *path);
+
+/* ---- adam.c -------------------------------------------------------------------------- */
+
+/* Allocate moments and per-thread gradient sinks for the field's current grids. */
+vf_status field_adam_alloc(field_adam *adam, const vf_field *f, int threads);
+void field_adam_free(field_adam *adam);
+
+/* Apply one Adam step to every point touched since the last step, summing the threads'
+ * gradients (plus total variation when weights are non-zero), then clear the sinks.
+ * lr[ch] is the learning rate of channel ch. */
+void field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
+                     float tv_color);
+
+/* Number of distinct points touched (for statistics). */
+size_t field_adam_touched(const field_adam *adam);
+
+#endif

@@ -1,0 +1,152 @@
+/* Ingest from a V4L2 webcam: capture for a while, writing every frame (already shrunk) into a
+ * scratch folder beside images/ while showing how many usable frames there are, then keep the
+ * chosen ones and drop the scratch folder. Frames go to disk, not memory, so the length of a
+ * capture is bounded by the disk only. */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "ingest_internal.h"
+#include "vf/log.h"
+
+#define CAPTURE_DIR ".capture"
+#define FRAME_TIMEOUT_MS 5000 /* a camera that sends nothing for this long has stopped */
+
+typedef struct capture_stats {
+    double seconds;    /* capture time */
+    long dropped;      /* frames the driver numbered but we never saw */
+    int width, height; /* size written */
+} capture_stats;
+
+/* The capture loop: read, score, write into capture_dir, until time or frame limit. */
+static vf_status capture(vf_v4l2 *cam, const vf_ingest_options *o, const char *capture_dir,
+                         score_list *scores, capture_stats *stats)
+{
+    const vf_v4l2_info *info = vf_v4l2_get_info(cam);
+    double fps = info->fps > 0 ? info->fps : 30;
+    size_t expected = o->frame_limit > 0 ? (size_t)o->frame_limit : (size_t)(o->seconds * fps);
+    vf_rgb8 frame = {0, 0, NULL};
+    vf_live_counter live = {0};
+    vf_progress progress;
+    vf_status status = VF_OK;
+    uint32_t sequence = 0, previous = 0;
+    double start = vf_now();
+    vf_progress_begin(&progress, "capturing", expected, "frames");
+    while (status == VF_OK && vf_now() - start < o->seconds &&
+           (o->frame_limit <= 0 || scores->count < o->frame_limit)) {
+        vf_frame_score score;
+        char name[32], note[64];
+        status = vf_v4l2_read(cam, FRAME_TIMEOUT_MS, &frame, &sequence);
+        if (status == VF_OK)
+            status = vf_score_frame(&frame, &score);
+        if (status == VF_OK) {
+            snprintf(name, sizeof name, "frame_%06d.jpg", scores->count);
+            status = ingest_save_frame(capture_dir, name, &frame, o->max_size, &stats->width,
+                                       &stats->height);
+        }
+        if (status == VF_OK)
+            status = score_list_push(scores, &score);
+        if (status != VF_OK)
+            break;
+        if (scores->count > 1 && sequence - previous > 1)
+            stats->dropped += (long)(sequence - previous - 1);
+        previous = sequence;
+        vf_live_counter_add(&live, &score, &o->select);
+        snprintf(note, sizeof note, "%d usable", live.usable);
+        if (progress.total < (size_t)scores->count)
+            progress.total = (size_t)scores->count;
+        vf_progress_update(&progress, (size_t)scores->count, note);
+    }
+    vf_progress_end(&progress);
+    stats->seconds = vf_now() - start;
+    vf_rgb8_free(&frame);
+    return status;
+}
+
+/* Open, start and capture; the device is closed again before returning. */
+static vf_status record(const char *device, const vf_ingest_options *o, const char *capture_dir,
+                        score_list *scores, capture_stats *stats, json_t *report)
+{
+    vf_v4l2_request request = {o->width, o->height, o->pixel_format, 0};
+    vf_v4l2 *cam;
+    vf_status status = vf_v4l2_open(device, o->ops, &request, &cam);
+    if (status != VF_OK)
+        return status;
+    const vf_v4l2_info *info = vf_v4l2_get_info(cam);
+    char fourcc[5];
+    vf_fourcc_text(info->pixel_format, fourcc);
+    vf_info("%s (%s): %dx%d %s, capturing for %.3g s", device, info->card, info->width,
+            info->height, fourcc, o->seconds);
+    json_object_set_new(report, "card", json_string(info->card));
+    json_object_set_new(report, "driver", json_string(info->driver));
+    json_object_set_new(report, "pixel_format", json_string(fourcc));
+    json_object_set_new(report, "width", json_integer(info->width));
+    json_object_set_new(report, "height", json_integer(info->height));
+    json_object_set_new(report, "nominal_fps", json_real(info->fps));
+    status = vf_v4l2_start(cam);
+    if (status == VF_OK)
+        status = capture(cam, o, capture_dir, scores, stats);
+    vf_v4l2_close(cam);
+    return status;
+}
+
+/* Move the chosen frames from the scratch folder into images/. */
+static vf_status keep_chosen(const char *capture_dir, const char *images_dir,
+                             const vf_selection *sel, json_t *files)
+{
+    for (int k = 0; k < sel->chosen_count; k++) {
+        char name[32], from[VF_PATH_MAX], to[VF_PATH_MAX];
+        snprintf(name, sizeof name, "frame_%06d.jpg", sel->chosen[k]);
+        vf_status status = vf_path_join(from, sizeof from, capture_dir, name);
+        if (status == VF_OK)
+            status = vf_path_join(to, sizeof to, images_dir, name);
+        if (status == VF_OK && rename(from, to) != 0)
+            status = vf_fail(VF_EINTERNAL, "cannot move %s into %s", from, images_dir);
+        if (status != VF_OK)
+            return status;
+        json_array_append_new(files, json_string(name));
+    }
+    return vf_remove_tree(capture_dir);
+}
+
+vf_status vf_ingest_camera(const char *device, const vf_ingest_options *options,
+                           const char *out_dir, json_t **report_out)
+{
+    score_list scores = {0};
+    vf_selection sel = {0};
+    capture_stats stats = {0};
+    char capture_dir[VF_PATH_MAX], images_dir[VF_PATH_MAX];
+    json_t *report = ingest_report_new("camera", device), *files = json_array();
+
+    vf_status status = ingest_check_options(options);
+    if (status == VF_OK && !(options->seconds > 0))
+        status = vf_fail(VF_EINPUT, "the capture time must be positive, not %g s", options->seconds);
+    if (status == VF_OK)
+        status = vf_path_join(capture_dir, sizeof capture_dir, out_dir, CAPTURE_DIR);
+    if (status == VF_OK)
+        status = vf_mkdirs(capture_dir);
+    if (status == VF_OK)
+        status = record(device, options, capture_dir, &scores, &stats, report);
+    if (status == VF_OK && scores.count == 0)
+        status = vf_fail(VF_EINPUT, "camera %s gave no frames in %.3g s", device, stats.seconds);
+    if (status == VF_OK) {
+        json_object_set_new(report, "frame_count", json_integer(scores.count));
+        json_object_set_new(report, "seconds", json_real(stats.seconds));
+        json_object_set_new(report, "fps", json_real(scores.count / stats.seconds));
+        json_object_set_new(report, "dropped", json_integer(stats.dropped));
+        status = ingest_select(&scores, &options->select, device, report, &sel);
+    }
+    if (status == VF_OK)
+        status = ingest_make_images_dir(out_dir, images_dir);
+    if (status == VF_OK)
+        status = keep_chosen(capture_dir, images_dir, &sel, files);
+    if (status == VF_OK) {
+        status = ingest_finish(report, files, stats.width, stats.height, &scores, &sel, out_dir,
+                               report_out);
+        report = files = NULL;
+    }
+    json_decref(report);
+    json_decref(files);
+    vf_selection_free(&sel);
+    score_list_free(&scores);
+    return status;
+}

@@ -1,0 +1,221 @@
+/* Ingest from a folder of photos: score them all (in parallel), choose, write the chosen ones. */
+#define _GNU_SOURCE
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "ingest_internal.h"
+#include "vf/log.h"
+
+typedef struct photo_list {
+    char **names; /* file names in the folder, sorted */
+    int count;
+} photo_list;
+
+static void photo_list_free(photo_list *list)
+{
+    for (int i = 0; i < list->count; i++)
+        free(list->names[i]);
+    free(list->names);
+    memset(list, 0, sizeof *list);
+}
+
+static int is_photo_name(const char *name)
+{
+    const char *dot = strrchr(name, '.');
+    return name[0] != '.' && dot &&
+           (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg") || !strcasecmp(dot, ".png"));
+}
+
+static int compare_names(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+static vf_status list_photos(const char *folder, photo_list *list)
+{
+    memset(list, 0, sizeof *list);
+    DIR *dir = opendir(folder);
+    if (!dir)
+        return vf_fail(VF_EINPUT, "cannot open folder %s", folder);
+    struct dirent *entry;
+    int capacity = 0;
+    vf_status status = VF_OK;
+    while (status == VF_OK && (entry = readdir(dir))) {
+        if (!is_photo_name(entry->d_name))
+            continue;
+        if (list->count == capacity) {
+            capacity = capacity ? 2 * capacity : 64;
+            char **names = realloc(list->names, sizeof *names * (size_t)capacity);
+            if (!names) {
+                status = vf_fail(VF_EINTERNAL, "out of memory listing %s", folder);
+                break;
+            }
+            list->names = names;
+        }
+        if (!(list->names[list->count] = strdup(entry->d_name)))
+            status = vf_fail(VF_EINTERNAL, "out of memory listing %s", folder);
+        else
+            list->count++;
+    }
+    closedir(dir);
+    if (status == VF_OK && list->count == 0)
+        status = vf_fail(VF_EINPUT,
+                         "folder %s has no JPEG or PNG photos; give a folder of photos or a "
+                         "video file",
+                         folder);
+    if (status != VF_OK)
+        photo_list_free(list);
+    else
+        qsort(list->names, (size_t)list->count, sizeof *list->names, compare_names);
+    return status;
+}
+
+/* Load and score every photo, in parallel; sizes gets width, height of each. */
+static vf_status score_photos(const char *folder, const photo_list *list, score_list *scores,
+                              int *sizes)
+{
+    vf_status status = VF_OK;
+    char message[1024] = ""; /* error messages are per thread: carry the first one out */
+    int done = 0;
+    vf_progress progress;
+    vf_progress_begin(&progress, "scoring photos", (size_t)list->count, "photos");
+#pragma omp parallel for schedule(dynamic)
+    for (int i = 0; i < list->count; i++) {
+        char path[VF_PATH_MAX];
+        vf_rgb8 photo = {0, 0, NULL};
+        vf_status s = vf_path_join(path, sizeof path, folder, list->names[i]);
+        if (s == VF_OK)
+            s = vf_rgb8_load(path, &photo);
+        if (s == VF_OK) {
+            s = vf_score_frame(&photo, &scores->items[i]);
+            sizes[2 * i] = photo.width;
+            sizes[2 * i + 1] = photo.height;
+        }
+        vf_rgb8_free(&photo);
+#pragma omp critical
+        {
+            if (s != VF_OK && status == VF_OK) {
+                status = s;
+                snprintf(message, sizeof message, "%s", vf_error_message());
+            }
+            vf_progress_update(&progress, (size_t)++done, NULL);
+        }
+    }
+    vf_progress_end(&progress);
+    return status == VF_OK ? VF_OK : vf_fail(status, "%s", message);
+}
+
+/* The name a photo is written under: its index (unique even if names repeat) and stem. */
+static void output_name(const photo_list *list, int index, char *out, size_t size)
+{
+    char stem[VF_PATH_MAX];
+    vf_path_basename(stem, sizeof stem, list->names[index], 1);
+    snprintf(out, size, "%04d_%.200s.jpg", index, stem);
+}
+
+/* Load, shrink and write the chosen photos, in parallel. */
+static vf_status write_photos(const char *folder, const photo_list *list, const vf_selection *sel,
+                              int max_size, const char *images_dir, int *width, int *height)
+{
+    vf_status status = VF_OK;
+    char message[1024] = "";
+#pragma omp parallel for schedule(dynamic)
+    for (int k = 0; k < sel->chosen_count; k++) {
+        int i = sel->chosen[k];
+        char path[VF_PATH_MAX], name[256];
+        vf_rgb8 photo = {0, 0, NULL};
+        output_name(list, i, name, sizeof name);
+        vf_status s = vf_path_join(path, sizeof path, folder, list->names[i]);
+        if (s == VF_OK)
+            s = vf_rgb8_load(path, &photo);
+        if (s == VF_OK)
+            s = ingest_save_frame(images_dir, name, &photo, max_size, k ? NULL : width,
+                                  k ? NULL : height);
+        vf_rgb8_free(&photo);
+#pragma omp critical
+        if (s != VF_OK && status == VF_OK) {
+            status = s;
+            snprintf(message, sizeof message, "%s", vf_error_message());
+        }
+    }
+    return status == VF_OK ? VF_OK : vf_fail(status, "%s", message);
+}
+
+/* Photo names and sizes, and how many are portrait or landscape (warning when mixed: later
+ * stages cope, but a phone turned halfway through a capture is worth knowing about). */
+static void describe_photos(json_t *report, const char *folder, const photo_list *list,
+                            const int *sizes)
+{
+    int portrait = 0, landscape = 0;
+    json_t *names = json_array();
+    for (int i = 0; i < list->count; i++) {
+        portrait += sizes[2 * i + 1] > sizes[2 * i];
+        landscape += sizes[2 * i] > sizes[2 * i + 1];
+        json_array_append_new(names, json_string(list->names[i]));
+    }
+    int mixed = portrait > 0 && landscape > 0;
+    if (mixed)
+        vf_warn("%s mixes %d portrait and %d landscape photos; they are kept as they are",
+                folder, portrait, landscape);
+    json_object_set_new(report, "frame_count", json_integer(list->count));
+    json_object_set_new(report, "width", json_integer(sizes[0]));
+    json_object_set_new(report, "height", json_integer(sizes[1]));
+    json_object_set_new(report, "orientation",
+                        json_pack("{s:i, s:i, s:i, s:b}", "portrait", portrait, "landscape",
+                                  landscape, "square", list->count - portrait - landscape,
+                                  "mixed", mixed));
+    json_object_set_new(report, "photos", names);
+}
+
+vf_status vf_ingest_photos(const char *folder, const vf_ingest_options *options,
+                           const char *out_dir, json_t **report_out)
+{
+    photo_list list;
+    score_list scores = {0};
+    vf_selection sel = {0};
+    char images_dir[VF_PATH_MAX];
+    int width = 0, height = 0, *sizes = NULL;
+    json_t *report = NULL, *files = NULL;
+
+    vf_status status = ingest_check_options(options);
+    if (status == VF_OK)
+        status = list_photos(folder, &list);
+    if (status != VF_OK)
+        return status;
+    scores.items = calloc((size_t)list.count, sizeof *scores.items);
+    scores.count = scores.capacity = list.count;
+    sizes = calloc((size_t)list.count * 2, sizeof *sizes);
+    if (!scores.items || !sizes)
+        status = vf_fail(VF_EINTERNAL, "out of memory for %d photos", list.count);
+    if (status == VF_OK)
+        status = score_photos(folder, &list, &scores, sizes);
+    if (status == VF_OK) {
+        vf_info("%s: %d photos", folder, list.count);
+        report = ingest_report_new("photos", folder);
+        describe_photos(report, folder, &list, sizes);
+        status = ingest_select(&scores, &options->select, folder, report, &sel);
+    }
+    if (status == VF_OK)
+        status = ingest_make_images_dir(out_dir, images_dir);
+    if (status == VF_OK)
+        status = write_photos(folder, &list, &sel, options->max_size, images_dir, &width, &height);
+    if (status == VF_OK) {
+        files = json_array();
+        for (int k = 0; k < sel.chosen_count; k++) {
+            char name[256];
+            output_name(&list, sel.chosen[k], name, sizeof name);
+            json_array_append_new(files, json_string(name));
+        }
+        status = ingest_finish(report, files, width, height, &scores, &sel, out_dir, report_out);
+        report = NULL;
+    }
+    json_decref(report);
+    vf_selection_free(&sel);
+    score_list_free(&scores);
+    free(sizes);
+    photo_list_free(&list);
+    return status;
+}

@@ -1,0 +1,39 @@
+/* tests/check.h: the tiny test harness every tests/test_*.c uses.
+ *
+ * CHECK(cond, ...) records a failure with a message and carries on; CHECK_NEAR compares
+ * numbers with a tolerance. check_finish() prints "N passed, N failed" and returns the exit
+ * code. vf_test_shared(rel) gives a path under ../shared (or $VF_SHARED_DIR); vf_test_tmpdir()
+ * makes a fresh scratch folder for the test. */
+#ifndef VF_TEST_CHECK_H
+#define VF_TEST_CHECK_H
+
+#include <math.h>
+#include <stdio.h>
+
+extern int check_passed, check_failed;
+
+#define CHECK(cond, ...)                                                                   \
+    do {                                                                                   \
+        if (cond) {                                                                        \
+            check_passed++;                                                                \
+        } else {                                                                           \
+            check_failed++;                                                                \
+            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond);       \
+            fprintf(stderr, __VA_ARGS__);                                                  \
+            fputc('\n', stderr);                                                           \
+        }                                                                                  \
+    } while (0)
+
+#define CHECK_NEAR(a, b, tol)                                                              \
+    CHECK(fabs((double)(a) - (double)(b)) <= (tol), "%s = %.9g, %s = %.9g, tolerance %g", #a, \
+          (double)(a), #b, (double)(b), (double)(tol))
+
+/* Path under the shared folder (models/, data/); the buffer is static per call slot. */
+const char *vf_test_shared(const char *relative);
+/* A new empty scratch folder, removed at check_finish() unless VF_KEEP_TMP is set. */
+const char *vf_test_tmpdir(void);
+/* Run a shell command, return its exit status (-1 when it could not run). */
+int vf_test_system(const char *fmt, ...);
+int check_finish(void);
+
+#endif

@@ -1,0 +1,212 @@
+/* `vfcapture poses` on the instant-ngp fox: 50 real phone photos (540x960) with reference poses
+ * from instant-ngp's own COLMAP run. COLMAP runs once; then: every frame registers in one model
+ * with sub-pixel reprojection error, in under 3 minutes; after a similarity alignment of the
+ * camera centres, the rotations and positions agree with the reference; and the outputs are
+ * consistent with each other (object frame, normalization.json, undistorted set).
+ * Give a workspace as argv[1] to check an earlier run instead of running COLMAP. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "poses_helpers.h"
+#include "vf/colmap_model.h"
+#include "vf/dataset.h"
+#include "vf/pose.h"
+
+#define FOX "data/real_captures/instant_ngp_fox"
+
+static void position(const double c2w[16], double p[3])
+{
+    vf_mat4_translation(c2w, p);
+}
+
+/* The reference frame whose image file name ends ours ("0001.jpg", or "0000_0001.jpg" as
+ * `ingest --transforms` names it), or NULL. */
+static const vf_frame *find_reference(const vf_dataset *ref, const char *path)
+{
+    char name[256], other[256];
+    vf_path_basename(name, sizeof name, path, 0);
+    size_t len = strlen(name);
+    for (int i = 0; i < ref->count; i++) {
+        vf_path_basename(other, sizeof other, ref->frames[i].image_path, 0);
+        size_t olen = strlen(other);
+        if (olen <= len && !strcmp(name + len - olen, other))
+            return &ref->frames[i];
+    }
+    return NULL;
+}
+
+/* Align the reference onto our object frame (Umeyama on camera centres) and measure rotation
+ * error (degrees) and position error (share of the mean camera distance, 4). */
+static void compare_with_reference(const vf_dataset *ours, const vf_dataset *ref)
+{
+    int n = ours->count;
+    double *src = malloc(sizeof(double) * 3 * n), *dst = malloc(sizeof(double) * 3 * n);
+    const vf_frame **match = malloc(sizeof *match * n);
+    int matched = 0;
+    for (int i = 0; i < n; i++) {
+        match[i] = find_reference(ref, ours->frames[i].image_path);
+        if (match[i]) {
+            position(match[i]->c2w, src + 3 * i);
+            position(ours->frames[i].c2w, dst + 3 * i);
+            matched++;
+        }
+    }
+    CHECK(matched == n, "every frame has a reference (%d of %d)", matched, n);
+    vf_similarity align;
+    CHECK(vf_similarity_umeyama(src, dst, n, &align) == VF_OK, "alignment: %s", vf_error_message());
+
+    double *rot_err = malloc(sizeof(double) * n), *pos_err = malloc(sizeof(double) * n);
+    for (int i = 0; i < n; i++) {
+        double moved[16], r_ours[9], r_ref[9], p[3];
+        vf_similarity_apply_c2w(&align, match[i]->c2w, moved);
+        vf_mat4_rotation(moved, r_ref);
+        vf_mat4_rotation(ours->frames[i].c2w, r_ours);
+        rot_err[i] = vf_rot_angle_deg(r_ours, r_ref);
+        vf_mat4_translation(moved, p);
+        double d2 = 0;
+        for (int k = 0; k < 3; k++)
+            d2 += (p[k] - dst[3 * i + k]) * (p[k] - dst[3 * i + k]);
+        pos_err[i] = sqrt(d2) / VF_CAMERA_DISTANCE;
+    }
+    double rot_med = quantile(rot_err, n, 0.5), rot_p90 = quantile(rot_err, n, 0.9);
+    double pos_med = quantile(pos_err, n, 0.5), pos_p90 = quantile(pos_err, n, 0.9);
+    printf("rotation error: median %.3f deg, p90 %.3f deg; position error: median %.3f%%, "
+           "p90 %.3f%% of the camera distance\n",
+           rot_med, rot_p90, 100 * pos_med, 100 * pos_p90);
+    CHECK(rot_med < 1.0, "rotation error median %.3f deg", rot_med);
+    CHECK(rot_p90 < 1.5, "rotation error p90 %.3f deg", rot_p90);
+    CHECK(pos_med < 0.01, "position error median %.4f", pos_med);
+    CHECK(pos_p90 < 0.02, "position error p90 %.4f", pos_p90);
+    free(src);
+    free(dst);
+    free(match);
+    free(rot_err);
+    free(pos_err);
+}
+
+/* Object frame: mean camera distance 4 from the origin, mean camera up +z. */
+static void check_object_frame(const vf_dataset *ds)
+{
+    double distance = 0, up[3] = {0};
+    for (int i = 0; i < ds->count; i++) {
+        double p[3];
+        position(ds->frames[i].c2w, p);
+        distance += sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / ds->count;
+        for (int k = 0; k < 3; k++)
+            up[k] += ds->frames[i].c2w[4 * k + 1] / ds->count; /* camera y axis */
+    }
+    CHECK_NEAR(distance, 4.0, 1e-6);
+    double norm = sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+    CHECK(up[2] / norm > 0.9999, "mean camera up is +z: (%.4f %.4f %.4f)", up[0] / norm,
+          up[1] / norm, up[2] / norm);
+}
+
+/* normalization.json maps COLMAP's camera centres (sparse/) onto transforms.json's. */
+static void check_normalization(const char *poses_dir, const vf_dataset *ds)
+{
+    char path[VF_PATH_MAX];
+    snprintf(path, sizeof path, "%s/normalization.json", poses_dir);
+    json_t *doc = load_json(path);
+    json_t *fwd = json_object_get(doc, "object_from_colmap");
+    CHECK(fwd != NULL, "%s has object_from_colmap", path);
+    vf_similarity s = {.scale = json_number_value(json_object_get(fwd, "scale"))};
+    for (int r = 0; r < 3; r++) {
+        s.t[r] = json_number_value(json_array_get(json_object_get(fwd, "translation"), r));
+        for (int c = 0; c < 3; c++)
+            s.R[3 * r + c] = json_number_value(
+                json_array_get(json_array_get(json_object_get(fwd, "rotation"), r), c));
+    }
+    json_decref(doc);
+    vf_colmap_model model;
+    snprintf(path, sizeof path, "%s/sparse", poses_dir);
+    CHECK(vf_colmap_model_load(path, &model) == VF_OK, "sparse model: %s", vf_error_message());
+    double worst = 0;
+    for (int i = 0; i < model.image_count; i++) {
+        double c[3], moved[3], expected[3];
+        vf_colmap_image_center(&model.images[i], c);
+        vf_similarity_apply(&s, c, moved);
+        for (int j = 0; j < ds->count; j++)
+            if (strstr(ds->frames[j].image_path, model.images[i].name)) {
+                position(ds->frames[j].c2w, expected);
+                for (int k = 0; k < 3; k++)
+                    worst = fmax(worst, fabs(moved[k] - expected[k]));
+            }
+    }
+    CHECK(model.image_count == ds->count, "sparse model has every frame");
+    CHECK(worst < 1e-6, "normalization.json maps COLMAP's centres onto ours (off by %g)", worst);
+    vf_colmap_model_free(&model);
+}
+
+/* The undistorted set: same poses, pinhole cameras, images that exist. */
+static void check_undistorted(const char *poses_dir, const vf_dataset *ds)
+{
+    char path[VF_PATH_MAX];
+    vf_dataset und;
+    snprintf(path, sizeof path, "%s/transforms_undistorted.json", poses_dir);
+    CHECK(vf_dataset_load(path, &und) == VF_OK, "undistorted set: %s", vf_error_message());
+    CHECK(und.count == ds->count, "undistorted frames %d", und.count);
+    for (int i = 0; i < und.count && i < ds->count; i++) {
+        CHECK(!vf_camera_has_distortion(&und.frames[i].camera), "frame %d is pinhole", i);
+        double d = 0;
+        for (int k = 0; k < 16; k++)
+            d = fmax(d, fabs(und.frames[i].c2w[k] - ds->frames[i].c2w[k]));
+        CHECK(d < 1e-9, "frame %d has the same pose (off by %g)", i, d);
+    }
+    vf_dataset_free(&und);
+}
+
+int main(int argc, char **argv)
+{
+    char ws[VF_PATH_MAX], poses_dir[VF_PATH_MAX], out[VF_PATH_MAX], err[VF_PATH_MAX];
+    snprintf(out, sizeof out, "%s/out.json", vf_test_tmpdir());
+    snprintf(err, sizeof err, "%s/err.txt", vf_test_tmpdir());
+    if (argc > 1) {
+        snprintf(ws, sizeof ws, "%s", argv[1]);
+    } else {
+        snprintf(ws, sizeof ws, "%s/fox", vf_test_tmpdir());
+        CHECK(make_ingested_workspace(ws, vf_test_shared(FOX "/images"), 0) == 50,
+              "workspace with the 50 fox photos");
+        double seconds;
+        int rc = run_poses(ws, "--json", out, err, &seconds);
+        CHECK(rc == 0, "vfcapture poses exit %d (stderr in %s)", rc, err);
+        printf("vfcapture poses took %.1f s\n", seconds);
+        CHECK(seconds < 180, "took %.1f s, limit 180 s", seconds);
+        json_t *summary = load_json(out);
+        char *text = json_dumps(json_object_get(summary, "seconds"), JSON_COMPACT);
+        printf("summary: registered %lld of %lld, reprojection error %.3f px, steps %s\n",
+               json_integer_value(json_object_get(summary, "registered")),
+               json_integer_value(json_object_get(summary, "total")),
+               json_number_value(json_object_get(summary, "reprojection_error_px")),
+               text ? text : "?");
+        free(text);
+        CHECK(json_integer_value(json_object_get(summary, "registered")) == 50, "all registered");
+        CHECK(json_integer_value(json_object_get(summary, "models")) == 1, "one model");
+        CHECK(json_number_value(json_object_get(summary, "reprojection_error_px")) < 1.0,
+              "reprojection error under 1 px");
+        json_decref(summary);
+    }
+    snprintf(poses_dir, sizeof poses_dir, "%s/poses", ws);
+    const char *files[] = {"database.db", "colmap.log", "points3D.txt", "sparse/points3D.txt"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+        char path[VF_PATH_MAX];
+        snprintf(path, sizeof path, "%s/%s", poses_dir, files[i]);
+        CHECK(vf_is_file(path), "%s exists", path);
+    }
+
+    vf_dataset ours, ref;
+    char path[VF_PATH_MAX];
+    snprintf(path, sizeof path, "%s/transforms.json", poses_dir);
+    CHECK(vf_dataset_load(path, &ours) == VF_OK, "our poses: %s", vf_error_message());
+    CHECK(vf_dataset_load(vf_test_shared(FOX "/transforms.json"), &ref) == VF_OK,
+          "reference: %s", vf_error_message());
+    if (ours.count == 50 && ref.count == 50) {
+        compare_with_reference(&ours, &ref);
+        check_object_frame(&ours);
+        check_normalization(poses_dir, &ours);
+        check_undistorted(poses_dir, &ours);
+    }
+    vf_dataset_free(&ours);
+    vf_dataset_free(&ref);
+    return check_finish();
+}

@@ -1,0 +1,265 @@
+/* Image module: file round trips, alpha, resizing, cropping and error messages. */
+#include <string.h>
+
+#include "check.h"
+#include "vf/fsutil.h"
+#include "vf/image.h"
+
+static float *pixel(const vf_image *img, int x, int y)
+{
+    return img->data + ((size_t)y * img->width + x) * img->channels;
+}
+
+static void fill_pattern(vf_image *img)
+{
+    for (int y = 0; y < img->height; y++)
+        for (int x = 0; x < img->width; x++)
+            for (int c = 0; c < img->channels; c++)
+                pixel(img, x, y)[c] = (float)((x * 37 + y * 11 + c * 71) % 256) / 255.0f;
+}
+
+static double max_difference(const vf_image *a, const vf_image *b)
+{
+    double worst = 0;
+    size_t n = (size_t)a->width * a->height * a->channels;
+    for (size_t i = 0; i < n; i++)
+        worst = fmax(worst, fabs((double)a->data[i] - (double)b->data[i]));
+    return worst;
+}
+
+static const char *scratch(const char *name)
+{
+    static char path[VF_PATH_MAX];
+    vf_path_join(path, sizeof path, vf_test_tmpdir(), name);
+    return path;
+}
+
+static void test_png_round_trip(void)
+{
+    vf_image img, back = {0};
+    CHECK(vf_image_alloc(&img, 7, 5, 3) == VF_OK, "alloc");
+    fill_pattern(&img);
+    const char *path = scratch("pattern.png");
+    CHECK(vf_image_save(path, &img) == VF_OK, "save png: %s", vf_error_message());
+    CHECK(vf_image_load(path, &back) == VF_OK, "load png: %s", vf_error_message());
+    CHECK(back.width == 7 && back.height == 5 && back.channels == 3, "png size %dx%dx%d",
+          back.width, back.height, back.channels);
+    if (back.data)
+        CHECK(max_difference(&img, &back) <= 1.0 / 255, "png values differ by %g",
+              max_difference(&img, &back));
+    int w = 0, h = 0, c = 0;
+    CHECK(vf_image_info(path, &w, &h, &c) == VF_OK && w == 7 && h == 5 && c == 3,
+          "info %dx%dx%d", w, h, c);
+    vf_image_free(&back);
+    vf_image_free(&img);
+}
+
+static void test_exr_round_trip(void)
+{
+    vf_image img, back = {0};
+    CHECK(vf_image_alloc(&img, 6, 4, 4) == VF_OK, "alloc");
+    fill_pattern(&img);
+    img.data[0] = 3.75f; /* float formats keep values outside 0..1 */
+    img.data[1] = -0.125f;
+    img.data[2] = 1e-4f;
+    const char *path = scratch("pattern.exr");
+    CHECK(vf_image_save(path, &img) == VF_OK, "save exr: %s", vf_error_message());
+    CHECK(vf_image_load(path, &back) == VF_OK, "load exr: %s", vf_error_message());
+    CHECK(back.width == 6 && back.height == 4 && back.channels == 4, "exr size %dx%dx%d",
+          back.width, back.height, back.channels);
+    if (back.data)
+        CHECK(max_difference(&img, &back) <= 1e-6, "exr values differ by %g",
+              max_difference(&img, &back));
+    vf_image_free(&back);
+    vf_image_free(&img);
+}
+
+static void test_jpeg_drops_alpha(void)
+{
+    vf_image img, back = {0};
+    CHECK(vf_image_alloc(&img, 16, 16, 4) == VF_OK, "alloc");
+    for (int i = 0; i < 16 * 16; i++)
+        memcpy(img.data + 4 * i, (float[4]){0.8f, 0.4f, 0.2f, 0.5f}, sizeof(float[4]));
+    const char *path = scratch("flat.jpg");
+    CHECK(vf_image_save(path, &img) == VF_OK, "save jpg: %s", vf_error_message());
+    CHECK(vf_image_load(path, &back) == VF_OK, "load jpg: %s", vf_error_message());
+    CHECK(back.channels == 3, "jpeg has %d channels", back.channels);
+    if (back.data) {
+        CHECK_NEAR(pixel(&back, 8, 8)[0], 0.8, 0.02);
+        CHECK_NEAR(pixel(&back, 8, 8)[2], 0.2, 0.02);
+    }
+    vf_image_free(&back);
+    vf_image_free(&img);
+}
+
+/* Pixels: opaque red, half-transparent red, fully transparent green. */
+static void test_alpha_compositing(void)
+{
+    vf_image rgba, straight = {0}, on_white = {0}, on_black = {0};
+    CHECK(vf_image_alloc(&rgba, 3, 1, 4) == VF_OK, "alloc");
+    const float px[3][4] = {{1, 0, 0, 1}, {1, 0, 0, 128 / 255.0f}, {0, 1, 0, 0}};
+    memcpy(rgba.data, px, sizeof px);
+    const char *path = scratch("alpha.png");
+    CHECK(vf_image_save(path, &rgba) == VF_OK, "save: %s", vf_error_message());
+
+    /* Colour is stored and read back straight, not premultiplied. */
+    CHECK(vf_image_load(path, &straight) == VF_OK && straight.channels == 4, "load rgba");
+    if (straight.data)
+        CHECK_NEAR(pixel(&straight, 1, 0)[0], 1.0, 1e-6);
+
+    const float white[3] = {1, 1, 1}, black[3] = {0, 0, 0};
+    CHECK(vf_image_load_rgb(path, white, &on_white) == VF_OK, "load on white");
+    CHECK(vf_image_load_rgb(path, black, &on_black) == VF_OK, "load on black");
+    if (on_white.data && on_black.data) {
+        double a = 128 / 255.0;
+        CHECK(on_white.channels == 3, "rgb has %d channels", on_white.channels);
+        CHECK_NEAR(pixel(&on_white, 0, 0)[1], 0.0, 1e-6);
+        CHECK_NEAR(pixel(&on_white, 1, 0)[0], 1.0, 1e-6);
+        CHECK_NEAR(pixel(&on_white, 1, 0)[1], 1.0 - a, 1e-6);
+        CHECK_NEAR(pixel(&on_white, 2, 0)[0], 1.0, 1e-6);
+        CHECK_NEAR(pixel(&on_black, 1, 0)[0], a, 1e-6);
+        CHECK_NEAR(pixel(&on_black, 1, 0)[1], 0.0, 1e-6);
+        CHECK_NEAR(pixel(&on_black, 2, 0)[1], 0.0, 1e-6);
+    }
+    vf_image_free(&on_black);
+    vf_image_free(&on_white);
+    vf_image_free(&straight);
+    vf_image_free(&rgba);
+}
+
+static void test_grey_expands(void)
+{
+    vf_image grey, rgb = {0};
+    CHECK(vf_image_alloc(&grey, 2, 2, 1) == VF_OK, "alloc");
+    grey.data[3] = 0.6f;
+    const char *path = scratch("grey.png");
+    CHECK(vf_image_save(path, &grey) == VF_OK, "save grey: %s", vf_error_message());
+    CHECK(vf_image_load_rgb(path, (float[3]){1, 1, 1}, &rgb) == VF_OK, "load grey as rgb");
+    if (rgb.data) {
+        CHECK(rgb.channels == 3, "channels %d", rgb.channels);
+        for (int c = 0; c < 3; c++)
+            CHECK_NEAR(pixel(&rgb, 1, 1)[c], 0.6, 1.0 / 255);
+    }
+    vf_image_free(&rgb);
+    vf_image_free(&grey);
+}
+
+static void test_resize_constant(void)
+{
+    const int sizes[][2] = {{13, 7}, {80, 61}}; /* down and up */
+    vf_image img;
+    CHECK(vf_image_alloc(&img, 40, 30, 3) == VF_OK, "alloc");
+    for (size_t i = 0; i < 40 * 30 * 3; i++)
+        img.data[i] = 0.3f;
+    for (int s = 0; s < 2; s++) {
+        vf_image out = {0};
+        CHECK(vf_image_resize(&img, sizes[s][0], sizes[s][1], &out) == VF_OK, "resize: %s",
+              vf_error_message());
+        CHECK(out.width == sizes[s][0] && out.height == sizes[s][1] && out.channels == 3,
+              "resized to %dx%dx%d", out.width, out.height, out.channels);
+        double worst = 0;
+        for (size_t i = 0; out.data && i < (size_t)out.width * out.height * 3; i++)
+            worst = fmax(worst, fabs(out.data[i] - 0.3));
+        CHECK(worst < 1e-5, "constant image changed by %g after resize", worst);
+        vf_image_free(&out);
+    }
+    vf_image_free(&img);
+}
+
+/* A horizontal ramp (value = x centre / width) shrinks 4x to the same ramp. */
+static void test_resize_gradient(void)
+{
+    vf_image img, out = {0};
+    CHECK(vf_image_alloc(&img, 64, 8, 1) == VF_OK, "alloc");
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 64; x++)
+            pixel(&img, x, y)[0] = (x + 0.5f) / 64;
+    CHECK(vf_image_resize(&img, 16, 2, &out) == VF_OK, "resize: %s", vf_error_message());
+    for (int x = 2; out.data && x < 14; x++)
+        CHECK_NEAR(pixel(&out, x, 1)[0], (x + 0.5) / 16, 0.005);
+    for (int x = 1; out.data && x < 16; x++)
+        CHECK(pixel(&out, x, 0)[0] > pixel(&out, x - 1, 0)[0], "not increasing at x=%d", x);
+    vf_image_free(&out);
+    vf_image_free(&img);
+}
+
+static void test_center_crop(void)
+{
+    vf_image img, crop = {0};
+    CHECK(vf_image_alloc(&img, 6, 5, 2) == VF_OK, "alloc");
+    for (int y = 0; y < 5; y++)
+        for (int x = 0; x < 6; x++)
+            pixel(&img, x, y)[1] = (float)(10 * y + x);
+    CHECK(vf_image_center_crop(&img, 3, 2, &crop) == VF_OK, "crop: %s", vf_error_message());
+    /* Margins 3 and 3: the window starts at (1, 1). */
+    CHECK(crop.width == 3 && crop.height == 2 && crop.channels == 2, "crop size");
+    for (int y = 0; crop.data && y < 2; y++)
+        for (int x = 0; x < 3; x++)
+            CHECK(pixel(&crop, x, y)[1] == 10 * (y + 1) + x + 1, "crop (%d,%d) = %g", x, y,
+                  pixel(&crop, x, y)[1]);
+    vf_image_free(&crop);
+    CHECK(vf_image_center_crop(&img, 7, 2, &crop) == VF_EINPUT, "crop larger than the image");
+    vf_image_free(&img);
+}
+
+static void test_errors(void)
+{
+    vf_image img = {0};
+    const char *missing = scratch("missing.png");
+    CHECK(vf_image_load(missing, &img) == VF_EINPUT, "missing file");
+    CHECK(strstr(vf_error_message(), missing) && strstr(vf_error_message(), "does not exist"),
+          "message: %s", vf_error_message());
+
+    char text_file[VF_PATH_MAX];
+    snprintf(text_file, sizeof text_file, "%s", scratch("notes.png"));
+    CHECK(vf_write_file_atomic(text_file, "hello\n", 6) == VF_OK, "write text");
+    CHECK(vf_image_load(text_file, &img) == VF_EINPUT, "text file");
+    CHECK(strstr(vf_error_message(), text_file) && strstr(vf_error_message(), "not an image"),
+          "message: %s", vf_error_message());
+    int w, h, c;
+    CHECK(vf_image_info(text_file, &w, &h, &c) == VF_EINPUT, "info of a text file");
+    CHECK(img.data == NULL, "output untouched on failure");
+
+    vf_image small;
+    CHECK(vf_image_alloc(&small, 2, 2, 3) == VF_OK, "alloc");
+    CHECK(vf_image_save(scratch("x.bmpx"), &small) == VF_EINPUT, "unknown extension");
+    const char *nowhere = scratch("no/such/folder/x.png");
+    CHECK(vf_image_save(nowhere, &small) != VF_OK, "save into a missing folder");
+    CHECK(strstr(vf_error_message(), nowhere) != NULL, "message: %s", vf_error_message());
+    vf_image_free(&small);
+}
+
+static void test_real_frame(void)
+{
+    const char *path = vf_test_shared("data/nerf_synthetic/chair/train/r_0.png");
+    vf_image img = {0}, rgb = {0};
+    CHECK(vf_image_load(path, &img) == VF_OK, "load %s: %s", path, vf_error_message());
+    CHECK(img.width == 200 && img.height == 200 && img.channels == 4, "chair frame %dx%dx%d",
+          img.width, img.height, img.channels);
+    CHECK(vf_image_load_rgb(path, (float[3]){1, 1, 1}, &rgb) == VF_OK, "load rgb");
+    if (img.data && rgb.data) {
+        CHECK(pixel(&img, 0, 0)[3] == 0.0f, "corner is transparent");
+        CHECK(pixel(&rgb, 0, 0)[0] == 1.0f && pixel(&rgb, 0, 0)[2] == 1.0f, "corner is white");
+        int opaque = 0;
+        for (int i = 0; i < 200 * 200; i++)
+            opaque += img.data[4 * i + 3] > 0.99f;
+        CHECK(opaque > 2000 && opaque < 30000, "%d opaque chair pixels", opaque);
+    }
+    vf_image_free(&rgb);
+    vf_image_free(&img);
+}
+
+int main(void)
+{
+    test_png_round_trip();
+    test_exr_round_trip();
+    test_jpeg_drops_alpha();
+    test_alpha_compositing();
+    test_grey_expands();
+    test_resize_constant();
+    test_resize_gradient();
+    test_center_crop();
+    test_errors();
+    test_real_frame();
+    return check_finish();
+}
