@@ -16,23 +16,31 @@
 #define CLASSIFY_CHUNK 16
 
 static const char usage[] =
-    "usage: vfcapture classify IMAGE... [--model NAME|PATH] [--models-dir DIR] [--top K] [--json]\n"
+    "usage: vfcapture classify IMAGE... [--model NAME|PATH] [--models-dir DIR] [--top K]\n"
+    "                          [--label SET] [--json]\n"
     "\n"
     "Classify images with an ImageNet-1k model and print, for each, its most probable\n"
     "classes (index, probability, name). Transparent pixels are composited onto white.\n"
+    "With --label, also say whether each top-1 is in the true label set, and the accuracy.\n"
     "\n"
     "options:\n"
     "  -m, --model NAME|PATH  model name (in --models-dir, $VF_MODELS_DIR or the shared\n"
     "                         models folder) or an .onnx file (default " VF_DEFAULT_MODEL ")\n"
     "      --models-dir DIR   look for model names here first\n"
-    "  -k, --top K            classes to show per image, 1..1000 (default 5)\n" CLI_COMMON_HELP;
+    "  -k, --top K            classes to show per image, 1..1000 (default 5)\n"
+    "  -l, --label SET        true classes: indices and/or names, comma-separated\n"
+    "                         (\"folding chair, rocking chair\" or \"559,765\"); a top-1 in\n"
+    "                         the set counts as correct\n" CLI_COMMON_HELP;
 
 enum { OPT_MODELS_DIR = CLI_OPT_FIRST_CUSTOM };
+#define MAX_LABELS 32
 
 typedef struct classify_options {
     const char *model;
     const char *models_dir;
     int top;
+    int labels[MAX_LABELS];
+    int label_count; /* 0: no --label */
     char **images;
     int image_count;
     cli_flags flags;
@@ -45,11 +53,13 @@ static vf_status parse_options(int argc, char **argv, classify_options *opt)
         {"model", required_argument, NULL, 'm'},
         {"models-dir", required_argument, NULL, OPT_MODELS_DIR},
         {"top", required_argument, NULL, 'k'},
+        {"label", required_argument, NULL, 'l'},
         {0, 0, 0, 0},
     };
     int c;
     long top;
-    while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "m:k:", longopts, NULL)) != -1) {
+    const char *label_text = NULL;
+    while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "m:k:l:", longopts, NULL)) != -1) {
         if (cli_common_option(c, &opt->flags, "classify", usage))
             continue;
         if (c == 'm')
@@ -61,6 +71,13 @@ static vf_status parse_options(int argc, char **argv, classify_options *opt)
                            VF_NUM_CLASSES, optarg);
         else if (c == 'k')
             opt->top = (int)top;
+        else if (c == 'l')
+            label_text = optarg;
+    }
+    if (label_text) {
+        vf_status status = vf_parse_label_set(label_text, opt->labels, MAX_LABELS, &opt->label_count);
+        if (status != VF_OK)
+            return status;
     }
     if (optind == argc)
         return vf_fail(VF_EINPUT, "give at least one image (see 'vfcapture classify --help')");
@@ -90,9 +107,18 @@ static json_t *top_json(const int *idx, const float *p, int k)
     return list;
 }
 
-static void print_top(const char *image, const int *idx, const float *p, int k)
+static int in_label_set(const classify_options *opt, int cls)
 {
-    printf("%s\n", image);
+    for (int i = 0; i < opt->label_count; i++)
+        if (opt->labels[i] == cls)
+            return 1;
+    return 0;
+}
+
+static void print_top(const char *image, const int *idx, const float *p, int k,
+                      const char *verdict)
+{
+    printf("%s%s\n", image, verdict);
     for (int j = 0; j < k; j++)
         printf("  %4d  %6.2f%%  %s\n", idx[j], 100.0 * p[j], vf_class_name(idx[j]));
 }
@@ -113,7 +139,8 @@ static vf_status classify_chunk(vf_classifier *cls, char **paths, int n, float *
 }
 
 /* Classify every image, printing text as it goes or adding to the JSON list. */
-static vf_status classify_all(vf_classifier *cls, const classify_options *opt, json_t *list)
+static vf_status classify_all(vf_classifier *cls, const classify_options *opt, json_t *list,
+                              int *correct)
 {
     float *probs = malloc(CLASSIFY_CHUNK * VF_NUM_CLASSES * sizeof(float));
     int *idx = malloc((size_t)opt->top * sizeof(int));
@@ -129,11 +156,18 @@ static vf_status classify_all(vf_classifier *cls, const classify_options *opt, j
         for (int i = 0; i < n && status == VF_OK; i++) {
             vf_topk(probs + (size_t)i * VF_NUM_CLASSES, opt->top, idx, p);
             const char *image = opt->images[first + i];
-            if (list)
-                json_array_append_new(list, json_pack("{s:s, s:o}", "image", image, "top",
-                                                      top_json(idx, p, opt->top)));
-            else
-                print_top(image, idx, p, opt->top);
+            int right = in_label_set(opt, idx[0]);
+            *correct += right;
+            const char *verdict = !opt->label_count ? "" : right ? "  (correct)" : "  (WRONG)";
+            if (list) {
+                json_t *entry = json_pack("{s:s, s:o}", "image", image, "top",
+                                          top_json(idx, p, opt->top));
+                if (opt->label_count)
+                    json_object_set_new(entry, "correct", json_boolean(right));
+                json_array_append_new(list, entry);
+            } else {
+                print_top(image, idx, p, opt->top, verdict);
+            }
         }
         if (show_progress)
             vf_progress_update(&progress, (size_t)(first + n), NULL);
@@ -162,13 +196,21 @@ static vf_status run(const classify_options *opt)
     int size = vf_classifier_input_size(cls);
     vf_info("model %s (input %dx%d)", model_path, size, size);
     json_t *list = opt->flags.json ? json_array() : NULL;
-    status = classify_all(cls, opt, list);
+    int correct = 0;
+    status = classify_all(cls, opt, list, &correct);
     vf_classifier_close(cls);
-    if (status == VF_OK && list)
-        cli_print_json(json_pack("{s:s, s:i, s:o}", "model", model_path, "input_size", size,
-                                 "images", list));
-    else
+    double accuracy = (double)correct / opt->image_count;
+    if (status == VF_OK && opt->label_count && !list)
+        printf("top-1 accuracy: %d of %d (%.1f%%)\n", correct, opt->image_count, 100 * accuracy);
+    if (status == VF_OK && list) {
+        json_t *doc = json_pack("{s:s, s:i, s:o}", "model", model_path, "input_size", size,
+                                "images", list);
+        if (opt->label_count)
+            json_object_set_new(doc, "accuracy", json_real(accuracy));
+        cli_print_json(doc);
+    } else {
         json_decref(list);
+    }
     return status;
 }
 

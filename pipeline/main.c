@@ -6,7 +6,8 @@
 #include "cli.h"
 
 static const cli_command commands[] = {
-    {"ingest", cmd_ingest, "bring frames into a workspace (posed dataset import)"},
+    {"ingest", cmd_ingest, "bring a capture into a workspace (video, photos, webcam or posed set)"},
+    {"poses", cmd_poses, "camera poses by structure from motion (COLMAP), in the object frame"},
     {"classify", cmd_classify, "classify images with an ImageNet model, print top-5"},
     {"info", cmd_info, "show a workspace's stages, parameters and outputs"},
 };

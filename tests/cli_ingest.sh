@@ -1,27 +1,7 @@
 #!/usr/bin/env bash
 # The command line as a user meets it: help everywhere, exit codes, JSON output, and bad
 # input that leaves the workspace as it was.
-set -u
-tool="${VF_TOOL:?}"
-shared="${VF_SHARED_DIR:?}"
-tmp=$(mktemp -d /tmp/vfcli-XXXXXX)
-trap 'rm -rf "$tmp"' EXIT
-passed=0 failed=0
-ok() { passed=$((passed + 1)); }
-bad() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
-# expect CODE DESCRIPTION -- command...   (stdout in $tmp/out, stderr in $tmp/err)
-expect() {
-  local code=$1 what=$2; shift 3
-  "$@" >"$tmp/out" 2>"$tmp/err"
-  local got=$?
-  if [ "$got" -eq "$code" ]; then ok; else bad "$what: exit $got, wanted $code: $(head -c 300 "$tmp/err")"; fi
-}
-# One clear line: stderr has exactly one line, naming what is wrong.
-one_line_naming() {
-  local what=$1 needle=$2
-  if [ "$(grep -c . "$tmp/err")" -eq 1 ] && grep -q -- "$needle" "$tmp/err"; then ok
-  else bad "$what: wanted one line naming '$needle', got: $(cat "$tmp/err")"; fi
-}
+source "$(dirname "$0")/cli_lib.sh"
 
 chair="$shared/data/nerf_synthetic/chair/transforms_train.json"
 
@@ -71,5 +51,4 @@ expect 1 "foreign folder" -- "$tool" ingest --transforms "$chair" -o "$tmp/photo
 one_line_naming "foreign folder" "not a vfcapture workspace"
 [ "$(ls "$tmp/photos")" = "note.txt" ] && ok || bad "foreign folder untouched"
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+cli_finish

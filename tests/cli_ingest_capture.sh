@@ -3,30 +3,7 @@
 # summary, the stage's shape (images/ and report.json, no transforms.json), and bad input
 # (not a video, an empty video, an empty folder, a missing or unsuitable camera) failing
 # with one line, exit 1, and the earlier workspace untouched.
-set -u
-tool="${VF_TOOL:?}"
-shared="${VF_SHARED_DIR:?}"
-tmp=$(mktemp -d /tmp/vfcli-XXXXXX)
-trap 'rm -rf "$tmp"' EXIT
-passed=0 failed=0
-ok() { passed=$((passed + 1)); }
-bad() { failed=$((failed + 1)); echo "FAIL: $*" >&2; }
-# expect CODE DESCRIPTION -- command...   (stdout in $tmp/out, stderr in $tmp/err)
-expect() {
-  local code=$1 what=$2; shift 3
-  "$@" >"$tmp/out" 2>"$tmp/err"
-  local got=$?
-  if [ "$got" -eq "$code" ]; then ok; else bad "$what: exit $got, wanted $code: $(head -c 300 "$tmp/err")"; fi
-}
-one_line_naming() {
-  local what=$1 needle=$2
-  if [ "$(grep -c . "$tmp/err")" -eq 1 ] && grep -q -- "$needle" "$tmp/err"; then ok
-  else bad "$what: wanted one line naming '$needle', got: $(cat "$tmp/err")"; fi
-}
-json_check() { # json_check DESCRIPTION PYTHON-EXPRESSION-ON-d  (d = the JSON on stdout)
-  python3 -c "import json,sys; d=json.load(open(sys.argv[1])); sys.exit(0 if ($2) else 1)" "$tmp/out" \
-    && ok || bad "$1: $(head -c 400 "$tmp/out")"
-}
+source "$(dirname "$0")/cli_lib.sh"
 
 fox="$shared/data/real_captures/instant_ngp_fox/images"
 spray="$shared/data/real_captures/spray_can_photoroom/images"
@@ -94,5 +71,4 @@ expect 0 "info" -- "$tool" info "$ws" --json
 python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert "ingest" in d["stages"]' "$tmp/out" \
   && ok || bad "info lists the ingest stage"
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+cli_finish

@@ -76,10 +76,12 @@ static void test_accuracy(void)
     printf("mobilenet_v2_1.0_224_quant on %d imagenet_samples: top-1 %.1f%%, top-5 %.1f%% "
            "(%.1f ms/image)\n",
            n, 100.0 * top1 / n, 100.0 * top5 / n, 1000.0 * seconds / n);
-    /* An independent OpenCV pipeline (imread, crop, blobFromImage) also gets 84 of these 100
-     * (the 89.7% in models/README.md is over all 1000 classes); swapping RGB to BGR or leaving
-     * out the std division drops it to about 65. */
-    CHECK(top1 >= 0.80 * n, "top-1 %d of %d is below 80%%", top1, n);
+    /* The issue asked for 85%, but these 100 photos allow 84 under DESIGN.md's preprocessing:
+     * an independent OpenCV pipeline gets exactly 84 with linear, area, cubic and Lanczos
+     * resizing alike (the 89.7% in models/README.md is over 1000 photos). Swapping RGB to BGR or
+     * leaving out the std division drops it to about 65, so this bar still catches those. */
+    CHECK(top1 >= 84, "top-1 %d of %d is below 84", top1, n);
+    CHECK(top5 >= 95, "top-5 %d of %d is below 95", top5, n);
 
     /* One image on its own gives the same probabilities as inside the batch. */
     int size = vf_classifier_input_size(cls);
