@@ -54,6 +54,7 @@ int cli_parse_int(const char *text, long lo, long hi, long *out);
 int cmd_ingest(int argc, char **argv);
 int cmd_classify(int argc, char **argv);
 int cmd_info(int argc, char **argv);
+int cmd_benchmark(int argc, char **argv);
 int cmd_poses(int argc, char **argv);
 
 #endif

@@ -9,6 +9,7 @@ static const cli_command commands[] = {
     {"ingest", cmd_ingest, "bring a capture into a workspace (video, photos, webcam or posed set)"},
     {"poses", cmd_poses, "camera poses by structure from motion (COLMAP), in the object frame"},
     {"classify", cmd_classify, "classify images with an ImageNet model, print top-5"},
+    {"benchmark", cmd_benchmark, "ImageNet-V style set from attacked objects; score classifiers"},
     {"info", cmd_info, "show a workspace's stages, parameters and outputs"},
 };
 static const int command_count = sizeof commands / sizeof commands[0];

@@ -1,0 +1,212 @@
+/* vfcapture benchmark: an ImageNet-V style viewpoint benchmark from attacked workspaces
+ * (build), and any number of classifiers scored on it (eval). vf/vbench.h does the work. */
+#define _GNU_SOURCE
+#include <dirent.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "vf/fsutil.h"
+#include "vf/log.h"
+#include "vf/resources.h"
+#include "vf/vbench.h"
+
+#define MAX_MODELS 32
+
+static const char usage[] =
+    "usage: vfcapture benchmark build WS... -o DIR [--count N] [--seed S]\n"
+    "       vfcapture benchmark eval DIR [--models A,B,...|all] [--json]\n"
+    "\n"
+    "build: for each attacked workspace, render N images at viewpoints sampled from its\n"
+    "adversarial distribution p*(v) and N at its natural (training) viewpoints, as 256x256 PNG\n"
+    "files in DIR/images with an index (DIR/index.json, DIR/index.csv: object, label set,\n"
+    "split, viewpoint). DIR must not exist yet (or be empty).\n"
+    "eval: top-1 accuracy of each model on natural and on adversarial viewpoints, per object\n"
+    "and overall; a top-1 in the object's label set is correct. Writes DIR/results.csv,\n"
+    "DIR/results.md and DIR/accuracy.png (bar chart) and prints the table.\n"
+    "\n"
+    "options:\n"
+    "  -o, --output DIR       build: the folder to create\n"
+    "  -n, --count N          build: images per object and split (default 100)\n"
+    "      --seed S           build: sampling seed (default 0)\n"
+    "      --models LIST      eval: model names or .onnx paths, comma-separated, or 'all' for\n"
+    "                         every model in the shared models folder (default " VF_DEFAULT_MODEL
+    ")\n" CLI_COMMON_HELP;
+
+enum { OPT_SEED = CLI_OPT_FIRST_CUSTOM, OPT_MODELS };
+
+typedef struct benchmark_options {
+    const char *output, *models;
+    vf_vbench_build_options build;
+    cli_flags flags;
+} benchmark_options;
+
+static vf_status parse_options(int argc, char **argv, benchmark_options *opt)
+{
+    static const struct option longopts[] = {
+        CLI_COMMON_OPTIONS,
+        {"output", required_argument, NULL, 'o'},
+        {"count", required_argument, NULL, 'n'},
+        {"seed", required_argument, NULL, OPT_SEED},
+        {"models", required_argument, NULL, OPT_MODELS},
+        {0, 0, 0, 0},
+    };
+    int c;
+    long value;
+    while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "o:n:", longopts, NULL)) != -1) {
+        if (cli_common_option(c, &opt->flags, "benchmark", usage))
+            continue;
+        if (c == 'o') {
+            opt->output = optarg;
+        } else if (c == 'n') {
+            if (cli_parse_int(optarg, 1, 100000, &value) != 0)
+                return vf_fail(VF_EINPUT, "--count must be a whole number from 1 to 100000");
+            opt->build.count = (int)value;
+        } else if (c == OPT_SEED) {
+            if (cli_parse_int(optarg, 0, 2147483647L, &value) != 0)
+                return vf_fail(VF_EINPUT, "--seed must be a whole number >= 0");
+            opt->build.seed = (uint64_t)value;
+        } else if (c == OPT_MODELS) {
+            opt->models = optarg;
+        }
+    }
+    return VF_OK;
+}
+
+static int has_onnx_suffix(const char *name)
+{
+    size_t n = strlen(name);
+    return n > 5 && !strcmp(name + n - 5, ".onnx");
+}
+
+static int compare_strings(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* Every .onnx file in the shared models folder, sorted. */
+static vf_status all_models(char **paths, int *count)
+{
+    char dir[VF_PATH_MAX];
+    vf_status status = vf_shared_path("models", dir, sizeof dir);
+    DIR *d = status == VF_OK ? opendir(dir) : NULL;
+    if (status == VF_OK && !d)
+        return vf_fail(VF_EINPUT, "cannot list the models folder %s", dir);
+    struct dirent *e;
+    while (status == VF_OK && (e = readdir(d)))
+        if (has_onnx_suffix(e->d_name) && *count < MAX_MODELS &&
+            asprintf(&paths[(*count)++], "%s/%s", dir, e->d_name) < 0)
+            status = vf_fail(VF_EINTERNAL, "out of memory");
+    if (d)
+        closedir(d);
+    qsort(paths, (size_t)*count, sizeof *paths, compare_strings);
+    return status;
+}
+
+static vf_status resolve_models(const char *list, char **paths, int *count)
+{
+    *count = 0;
+    if (list && !strcmp(list, "all"))
+        return all_models(paths, count);
+    char *copy = strdup(list ? list : VF_DEFAULT_MODEL), *save = NULL;
+    vf_status status = copy ? VF_OK : vf_fail(VF_EINTERNAL, "out of memory");
+    for (char *name = copy ? strtok_r(copy, ",", &save) : NULL; name && status == VF_OK;
+         name = strtok_r(NULL, ",", &save)) {
+        char path[VF_PATH_MAX];
+        if (*count == MAX_MODELS)
+            status = vf_fail(VF_EINPUT, "at most %d models at once", MAX_MODELS);
+        if (status == VF_OK)
+            status = vf_find_model(name, NULL, path, sizeof path);
+        if (status == VF_OK && !(paths[(*count)++] = strdup(path)))
+            status = vf_fail(VF_EINTERNAL, "out of memory");
+    }
+    free(copy);
+    return status;
+}
+
+static void print_results(const vf_vbench_results *r, const char *dir)
+{
+    printf("%-34s %-16s %12s %12s\n", "model", "object", "natural", "adversarial");
+    for (int m = 0; m < r->model_count; m++) {
+        char model[256];
+        vf_path_basename(model, sizeof model, r->models[m], 1);
+        for (int o = 0; o <= r->object_count; o++) {
+            const vf_vbench_row *rows = r->rows + (m * (r->object_count + 1) + o) * 2;
+            printf("%-34s %-16s %6.1f%% %3d  %6.1f%% %3d\n", model,
+                   o < r->object_count ? r->objects[o] : "all",
+                   rows[0].total ? 100.0 * rows[0].correct / rows[0].total : 0.0, rows[0].total,
+                   rows[1].total ? 100.0 * rows[1].correct / rows[1].total : 0.0, rows[1].total);
+        }
+    }
+    printf("\nreports: %s/results.md, %s/results.csv, %s/accuracy.png\n", dir, dir, dir);
+}
+
+static json_t *results_json(const vf_vbench_results *r)
+{
+    json_t *rows = json_array();
+    for (int i = 0; i < r->row_count; i++) {
+        const vf_vbench_row *row = &r->rows[i];
+        json_array_append_new(
+            rows, json_pack("{s:s, s:s, s:s, s:i, s:i}", "model", r->models[row->model], "object",
+                            row->object < 0 ? "all" : r->objects[row->object], "split",
+                            row->split == VF_VBENCH_NATURAL ? "natural" : "adversarial",
+                            "correct", row->correct, "total", row->total));
+    }
+    return json_pack("{s:o}", "results", rows);
+}
+
+static int run_eval(const benchmark_options *opt, const char *dir)
+{
+    char *models[MAX_MODELS] = {0};
+    int count = 0;
+    vf_vbench_results results = {0};
+    vf_status status = resolve_models(opt->models, models, &count);
+    if (status == VF_OK)
+        status = vf_vbench_eval(dir, (const char *const *)models, count, &results);
+    if (status == VF_OK)
+        status = vf_vbench_write_reports(&results, dir);
+    if (status == VF_OK) {
+        if (opt->flags.json)
+            cli_print_json(results_json(&results));
+        else
+            print_results(&results, dir);
+    }
+    vf_vbench_results_free(&results);
+    for (int i = 0; i < count; i++)
+        free(models[i]);
+    return status == VF_OK ? 0 : cli_fail("benchmark", status);
+}
+
+int cmd_benchmark(int argc, char **argv)
+{
+    benchmark_options opt = {.build = {.count = 100}};
+    vf_status status = parse_options(argc, argv, &opt);
+    if (status != VF_OK)
+        return cli_fail("benchmark", status);
+    const char *action = optind < argc ? argv[optind] : "";
+    char **rest = argv + optind + 1;
+    int rest_count = argc - optind - 1;
+    if (!strcmp(action, "build")) {
+        if (rest_count < 1 || !opt.output)
+            status = vf_fail(VF_EINPUT, "give attacked workspaces and -o DIR "
+                                        "(see 'vfcapture benchmark --help')");
+        if (status == VF_OK)
+            status = vf_vbench_build((const char *const *)rest, rest_count, opt.output,
+                                     &opt.build);
+        if (status == VF_OK && !opt.flags.json)
+            printf("benchmark set written to %s (%d images per object and split)\n", opt.output,
+                   opt.build.count);
+        else if (status == VF_OK)
+            cli_print_json(json_pack("{s:s, s:i}", "set", opt.output, "count", opt.build.count));
+        return status == VF_OK ? 0 : cli_fail("benchmark", status);
+    }
+    if (!strcmp(action, "eval")) {
+        if (rest_count != 1) {
+            vf_fail(VF_EINPUT, "give one benchmark folder (see 'vfcapture benchmark --help')");
+            return cli_fail("benchmark", VF_EINPUT);
+        }
+        return run_eval(&opt, rest[0]);
+    }
+    vf_fail(VF_EINPUT, "say 'build' or 'eval' (see 'vfcapture benchmark --help')");
+    return cli_fail("benchmark", VF_EINPUT);
+}

@@ -1,0 +1,323 @@
+/* Building an ImageNet-V style set: natural and adversarial renders of attacked workspaces.
+ * The set is written to OUT.partial and renamed to OUT when complete. */
+#define _GNU_SOURCE
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <dirent.h>
+#include <jansson.h>
+#include <unistd.h>
+
+#include "vf/dataset.h"
+#include "vf/field.h"
+#include "vf/log.h"
+#include "vf/pose.h"
+#include "vf/rng.h"
+#include "vf/vbench.h"
+#include "vf/viewfool.h"
+#include "vf/workspace.h"
+
+#define RENDER_CHUNK 16
+
+/* What the set needs from one workspace. */
+typedef struct vbench_object {
+    char name[128];
+    vf_field *field;
+    json_t *labels;      /* {"indices": [...], "names": [...]} from attack.json */
+    vf_view_bounds bounds;
+    int components;
+    double mu[VF_ATTACK_MAX_COMPONENTS][VF_VIEW_DIM];
+    double sigma[VF_ATTACK_MAX_COMPONENTS][VF_VIEW_DIM];
+    double weight[VF_ATTACK_MAX_COMPONENTS];
+    vf_dataset natural;  /* the training cameras */
+} vbench_object;
+
+static void object_free(vbench_object *o)
+{
+    vf_field_free(o->field);
+    json_decref(o->labels);
+    vf_dataset_free(&o->natural);
+    memset(o, 0, sizeof *o);
+}
+
+static vf_status read_vector(const json_t *array, double *out, const char *what, const char *path)
+{
+    if (!json_is_array(array) || json_array_size(array) != VF_VIEW_DIM)
+        return vf_fail(VF_EINPUT, "%s: \"%s\" must hold %d numbers", path, what, VF_VIEW_DIM);
+    for (int i = 0; i < VF_VIEW_DIM; i++) {
+        const json_t *x = json_array_get(array, (size_t)i);
+        if (!json_is_number(x))
+            return vf_fail(VF_EINPUT, "%s: \"%s\" must hold numbers", path, what);
+        out[i] = json_number_value(x);
+    }
+    return VF_OK;
+}
+
+/* mu and sigma are one 6-vector (a single Gaussian) or a list of them (a mixture). */
+static vf_status read_components(const json_t *attack, vbench_object *o, const char *path)
+{
+    const json_t *mu = json_object_get(attack, "mu"), *sigma = json_object_get(attack, "sigma");
+    const json_t *weights = json_object_get(attack, "weights");
+    int mixture = json_is_array(mu) && json_is_array(json_array_get(mu, 0));
+    o->components = mixture ? (int)json_array_size(mu) : 1;
+    if (o->components < 1 || o->components > VF_ATTACK_MAX_COMPONENTS ||
+        (mixture && json_array_size(sigma) != json_array_size(mu)))
+        return vf_fail(VF_EINPUT, "%s: \"mu\" and \"sigma\" do not describe a distribution", path);
+    vf_status status = VF_OK;
+    for (int c = 0; c < o->components && status == VF_OK; c++) {
+        status = read_vector(mixture ? json_array_get(mu, (size_t)c) : mu, o->mu[c], "mu", path);
+        if (status == VF_OK)
+            status = read_vector(mixture ? json_array_get(sigma, (size_t)c) : sigma, o->sigma[c],
+                                 "sigma", path);
+        const json_t *w = json_array_get(weights, (size_t)c);
+        o->weight[c] = json_is_number(w) ? json_number_value(w) : 1.0 / o->components;
+    }
+    return status;
+}
+
+static vf_status load_attack(const vf_workspace *ws, vbench_object *o)
+{
+    char path[VF_PATH_MAX];
+    json_t *attack = NULL;
+    vf_status status = vf_workspace_path(ws, "attack", "attack.json", path, sizeof path);
+    if (status == VF_OK && !vf_workspace_has_stage(ws, "attack"))
+        status = vf_fail(VF_EINPUT, "%s has no attack yet: run 'vfcapture attack %s' first",
+                         ws->root, ws->root);
+    if (status == VF_OK)
+        status = vf_json_load(path, &attack);
+    const json_t *labels = json_object_get(attack, "label");
+    const json_t *bounds = json_object_get(attack, "bounds");
+    if (status == VF_OK && (!json_is_array(json_object_get(labels, "indices")) || !bounds))
+        status = vf_fail(VF_EINPUT, "%s: no \"label\" indices or \"bounds\"", path);
+    if (status == VF_OK)
+        status = read_vector(json_object_get(bounds, "lo"), o->bounds.lo, "bounds.lo", path);
+    if (status == VF_OK)
+        status = read_vector(json_object_get(bounds, "hi"), o->bounds.hi, "bounds.hi", path);
+    if (status == VF_OK)
+        status = read_components(attack, o, path);
+    if (status == VF_OK)
+        o->labels = json_incref((json_t *)labels);
+    json_decref(attack);
+    return status;
+}
+
+/* The cameras the field was trained on: the undistorted poses, or an imported posed set. */
+static vf_status load_natural_views(const vf_workspace *ws, vf_dataset *out)
+{
+    char path[VF_PATH_MAX];
+    vf_status status = vf_workspace_path(ws, "poses", "transforms_undistorted.json", path,
+                                         sizeof path);
+    if (status == VF_OK && !vf_is_file(path))
+        status = vf_workspace_path(ws, "ingest", "transforms.json", path, sizeof path);
+    if (status == VF_OK && !vf_is_file(path))
+        return vf_fail(VF_EINPUT, "%s has no posed training views", ws->root);
+    return status == VF_OK ? vf_dataset_load(path, out) : status;
+}
+
+static vf_status load_object(const char *root, vbench_object *o)
+{
+    vf_workspace ws;
+    char model[VF_PATH_MAX];
+    vf_status status = vf_workspace_open(root, 0, &ws);
+    if (status != VF_OK)
+        return status;
+    vf_path_basename(o->name, sizeof o->name, ws.root, 0);
+    status = load_attack(&ws, o);
+    if (status == VF_OK)
+        status = vf_workspace_path(&ws, "train", "model.vff", model, sizeof model);
+    if (status == VF_OK)
+        status = vf_field_load(model, &o->field);
+    if (status == VF_OK)
+        status = load_natural_views(&ws, &o->natural);
+    vf_workspace_close(&ws);
+    return status;
+}
+
+/* The 256-pixel camera whose centre 224 crop is the attack's classifier view. */
+static vf_camera photo_camera(const vf_field *f)
+{
+    vf_camera cam = vf_field_classifier_camera(f, 224);
+    int margin = (VF_VBENCH_IMAGE_SIZE - 224) / 2;
+    cam.width = cam.height = VF_VBENCH_IMAGE_SIZE;
+    cam.cx += margin;
+    cam.cy += margin;
+    return cam;
+}
+
+/* Viewpoint i of a split: a training camera (spread over them) or a sample of p*(v). */
+static void choose_view(const vbench_object *o, vf_vbench_split split, int i, int count,
+                        vf_rng *rng, double v[VF_VIEW_DIM], double c2w[16])
+{
+    if (split == VF_VBENCH_NATURAL) {
+        int frames = o->natural.count;
+        int f = count <= frames ? (int)((long)i * frames / count) : i % frames;
+        memcpy(c2w, o->natural.frames[f].c2w, 16 * sizeof *c2w);
+        vf_viewpoint p;
+        vf_c2w_to_viewpoint(c2w, &p);
+        vf_viewpoint_to_array(&p, v);
+        return;
+    }
+    double pick = vf_rng_uniform(rng), total = 0;
+    int c = 0;
+    for (; c < o->components - 1; c++)
+        if ((total += o->weight[c]) > pick)
+            break;
+    double u[VF_VIEW_DIM];
+    for (int d = 0; d < VF_VIEW_DIM; d++)
+        u[d] = o->mu[c][d] + o->sigma[c][d] * vf_rng_normal(rng);
+    vf_view_squash(&o->bounds, u, v);
+    vf_viewpoint p = vf_viewpoint_from_array(v);
+    vf_viewpoint_to_c2w(&p, c2w);
+}
+
+static const char *split_name(vf_vbench_split split)
+{
+    return split == VF_VBENCH_NATURAL ? "natural" : "adversarial";
+}
+
+/* Render one object's split, save the PNGs and add them to the index. */
+static vf_status render_split(const vbench_object *o, int object, vf_vbench_split split,
+                              const vf_vbench_build_options *opt, const char *dir, json_t *index,
+                              FILE *csv, vf_progress *progress, size_t *done)
+{
+    vf_rng rng;
+    vf_rng_seed(&rng, opt->seed + 1000003u * (uint64_t)object + (uint64_t)split);
+    vf_camera cam = photo_camera(o->field);
+    vf_image images[RENDER_CHUNK] = {{0}};
+    double views[RENDER_CHUNK][VF_VIEW_DIM], c2w[RENDER_CHUNK * 16];
+    vf_status status = VF_OK;
+    for (int first = 0; first < opt->count && status == VF_OK; first += RENDER_CHUNK) {
+        int n = opt->count - first < RENDER_CHUNK ? opt->count - first : RENDER_CHUNK;
+        for (int i = 0; i < n; i++)
+            choose_view(o, split, first + i, opt->count, &rng, views[i], c2w + 16 * i);
+        status = vf_field_render_batch(o->field, &cam, c2w, n, images);
+        for (int i = 0; i < n && status == VF_OK; i++) {
+            char file[256], path[VF_PATH_MAX];
+            snprintf(file, sizeof file, "images/%s_%s_%03d.png", o->name, split_name(split),
+                     first + i);
+            status = vf_path_join(path, sizeof path, dir, file);
+            if (status == VF_OK)
+                status = vf_image_save(path, &images[i]);
+            json_t *v = json_array();
+            for (int d = 0; d < VF_VIEW_DIM; d++)
+                json_array_append_new(v, json_real(views[i][d]));
+            json_array_append_new(index, json_pack("{s:s, s:i, s:s, s:o}", "file", file, "object",
+                                                   object, "split", split_name(split),
+                                                   "viewpoint", v));
+            fprintf(csv, "%s,%s,%s,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f\n", file, o->name,
+                    split_name(split), views[i][0], views[i][1], views[i][2], views[i][3],
+                    views[i][4], views[i][5]);
+        }
+        *done += (size_t)n;
+        vf_progress_update(progress, *done, o->name);
+    }
+    for (int i = 0; i < RENDER_CHUNK; i++)
+        vf_image_free(&images[i]);
+    return status;
+}
+
+static int dir_is_empty(const char *path)
+{
+    DIR *d = opendir(path);
+    struct dirent *e;
+    int empty = 1;
+    while (d && (e = readdir(d)))
+        if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+            empty = 0;
+    if (d)
+        closedir(d);
+    return empty;
+}
+
+static void make_names_unique(vbench_object *objects, int n)
+{
+    for (int i = 1; i < n; i++)
+        for (int j = 0; j < i; j++)
+            if (!strcmp(objects[i].name, objects[j].name)) {
+                size_t len = strlen(objects[i].name);
+                snprintf(objects[i].name + len, sizeof objects[i].name - len, "_%d", i + 1);
+                break;
+            }
+}
+
+static vf_status write_set(vbench_object *objects, int n, const char *dir,
+                           const vf_vbench_build_options *opt)
+{
+    char path[VF_PATH_MAX];
+    vf_status status = vf_path_join(path, sizeof path, dir, "images");
+    if (status == VF_OK)
+        status = vf_mkdirs(path);
+    if (status == VF_OK)
+        status = vf_path_join(path, sizeof path, dir, "index.csv");
+    FILE *csv = status == VF_OK ? fopen(path, "w") : NULL;
+    if (status == VF_OK && !csv)
+        return vf_fail(VF_EINPUT, "cannot write %s", path);
+    if (csv)
+        fputs("file,object,split,psi,theta,phi,dx,dy,dz\n", csv);
+
+    json_t *index = json_array(), *object_list = json_array();
+    vf_progress progress;
+    size_t done = 0;
+    vf_progress_begin(&progress, "rendering", (size_t)n * 2 * opt->count, "images");
+    for (int o = 0; o < n && status == VF_OK; o++) {
+        json_array_append_new(object_list,
+                              json_pack("{s:s, s:O}", "name", objects[o].name, "label",
+                                        objects[o].labels));
+        for (int split = 0; split < 2 && status == VF_OK; split++)
+            status = render_split(&objects[o], o, (vf_vbench_split)split, opt, dir, index, csv,
+                                  &progress, &done);
+    }
+    if (csv && fclose(csv) != 0 && status == VF_OK)
+        status = vf_fail(VF_EINPUT, "cannot write %s (disk full?)", path);
+    if (status == VF_OK)
+        vf_progress_end(&progress);
+    json_t *doc = json_pack("{s:i, s:i, s:I, s:o, s:o}", "image_size", VF_VBENCH_IMAGE_SIZE,
+                            "count", opt->count, "seed", (json_int_t)opt->seed, "objects",
+                            object_list, "images", index);
+    if (status == VF_OK)
+        status = vf_path_join(path, sizeof path, dir, "index.json");
+    if (status == VF_OK)
+        status = vf_json_save(path, doc);
+    json_decref(doc);
+    return status;
+}
+
+vf_status vf_vbench_build(const char *const *workspaces, int n, const char *out_dir,
+                          const vf_vbench_build_options *opt)
+{
+    if (n < 1 || opt->count < 1)
+        return vf_fail(VF_EINPUT, "give at least one workspace and a positive image count");
+    if (vf_is_file(out_dir) || (vf_is_dir(out_dir) && !dir_is_empty(out_dir)))
+        return vf_fail(VF_EINPUT, "%s already exists: choose a new output folder", out_dir);
+    vbench_object *objects = calloc((size_t)n, sizeof *objects);
+    if (!objects)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    vf_status status = VF_OK;
+    for (int i = 0; i < n && status == VF_OK; i++)
+        status = load_object(workspaces[i], &objects[i]);
+    make_names_unique(objects, n);
+
+    char partial[VF_PATH_MAX];
+    if (status == VF_OK && snprintf(partial, sizeof partial, "%s.partial", out_dir) >=
+                               (int)sizeof partial)
+        status = vf_fail(VF_EINPUT, "output path too long: %s", out_dir);
+    if (status == VF_OK) {
+        vf_remove_tree(partial);
+        status = vf_mkdirs(partial);
+    }
+    if (status == VF_OK)
+        status = write_set(objects, n, partial, opt);
+    if (status == VF_OK) {
+        if (vf_is_dir(out_dir))
+            rmdir(out_dir); /* empty, checked above */
+        if (rename(partial, out_dir) != 0)
+            status = vf_fail(VF_EINTERNAL, "cannot move %s into place", partial);
+    } else {
+        vf_remove_tree(partial);
+    }
+    for (int i = 0; i < n; i++)
+        object_free(&objects[i]);
+    free(objects);
+    return status;
+}
