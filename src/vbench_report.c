@@ -91,7 +91,7 @@ static void draw_text(cairo_t *cr, double x, double y, double size, const char *
 static vf_status write_chart(const vf_vbench_results *r, const char *path)
 {
     const double group = 120, left = 60, top = 50, plot_h = 300, bottom = 90;
-    int width = (int)(left + group * r->model_count + 30), height = (int)(top + plot_h + bottom);
+    int width = (int)(left + group * r->model_count + 110), height = (int)(top + plot_h + bottom);
     if (width < 420)
         width = 420;
     cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height);
