@@ -12,7 +12,11 @@
  * Peak memory is the process's resident high-water mark during each training run. Timings
  * are wall clock on all cores; expect +-10% when other work shares the machine.
  *
- * usage: bench_field [SCENE...] [--minutes 1,2,3,5] [--set option=value]... */
+ * --model PATH renders (and scores on the chair test views) a saved model instead of training
+ * one; --save PATH saves the last chair model trained.
+ *
+ * usage: bench_field [SCENE...] [--minutes 1,2,3,5] [--set option=value]... [--model PATH]
+ *                    [--save PATH] */
 #define _GNU_SOURCE
 #include <omp.h>
 #include <stdio.h>
@@ -275,6 +279,7 @@ int main(int argc, char **argv)
     double minutes[8] = {1, 2, 3, 5};
     int minute_count = 4;
     int want_chair = 0, want_lego = 0, want_fox = 0, want_render = 0;
+    const char *model_path = NULL, *save_path = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--minutes") && i + 1 < argc) {
             minute_count = 0;
@@ -283,6 +288,10 @@ int main(int argc, char **argv)
                 if (*p == ',')
                     p++;
             }
+        } else if (!strcmp(argv[i], "--model") && i + 1 < argc) {
+            model_path = argv[++i];
+        } else if (!strcmp(argv[i], "--save") && i + 1 < argc) {
+            save_path = argv[++i];
         } else if (!strcmp(argv[i], "--set") && i + 1 < argc) {
             apply_setting(&base, argv[++i]);
         } else if (!strcmp(argv[i], "chair")) {
@@ -295,7 +304,7 @@ int main(int argc, char **argv)
             want_render = 1;
         } else {
             fprintf(stderr, "usage: bench_field [chair] [lego] [fox] [render] [--minutes 1,2,3,5] "
-                            "[--set option=value]...\n");
+                            "[--set option=value]... [--model PATH] [--save PATH]\n");
             return 1;
         }
     }
@@ -309,7 +318,14 @@ int main(int argc, char **argv)
         load_views("data/nerf_synthetic/chair/transforms_train.json", 0, &train_views, NULL);
         load_views("data/nerf_synthetic/chair/transforms_test.json", 0, &test_views, NULL);
         vf_field *last = NULL;
-        for (int m = 0; want_chair && m < minute_count; m++) {
+        if (model_path) {
+            if (vf_field_load(model_path, &last) != VF_OK)
+                die(model_path);
+            run_result r = {0};
+            evaluate(last, &test_views, white, &r);
+            printf("model %s: chair test PSNR %.3f dB  SSIM %.4f\n", model_path, r.psnr, r.ssim);
+        }
+        for (int m = 0; want_chair && !model_path && m < minute_count; m++) {
             vf_field_train_options opt = base;
             opt.seconds = base.seconds > 0 ? minutes[m] * 60 : 0;
             run_result r;
@@ -320,6 +336,8 @@ int main(int argc, char **argv)
             vf_field_free(last);
             last = f;
         }
+        if (save_path && last && vf_field_save(last, save_path) != VF_OK)
+            die(save_path);
         if (want_render) {
             if (!last) {
                 vf_field_train_options opt = base;

@@ -56,5 +56,16 @@ int cmd_classify(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_benchmark(int argc, char **argv);
 int cmd_poses(int argc, char **argv);
+int cmd_train(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+int cmd_eval(int argc, char **argv);
+int cmd_run(int argc, char **argv);
+int cmd_calib(int argc, char **argv);
+int cmd_attack(int argc, char **argv);
+int cmd_transfer(int argc, char **argv);
+int cmd_localize(int argc, char **argv);
+int cmd_score(int argc, char **argv);
+int cmd_export(int argc, char **argv);
+int cmd_reshoot(int argc, char **argv);
 
 #endif

@@ -7,6 +7,7 @@
 #define _GNU_SOURCE
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -415,8 +416,9 @@ static vf_status run_stage(poses_run *run, const vf_workspace *ws, json_t **summ
  * /tmp) and name it at the end of the message; `status` is returned unchanged. */
 static vf_status keep_failure_log(const poses_run *run, vf_status status)
 {
-    if (!run->colmap.log_path[0] || !vf_is_file(run->colmap.log_path))
-        return status;
+    struct stat info;
+    if (!run->colmap.log_path[0] || stat(run->colmap.log_path, &info) != 0 || info.st_size == 0)
+        return status; /* no log, or COLMAP never ran */
     const char *tmp = getenv("TMPDIR");
     char copy[VF_PATH_MAX], message[1024];
     snprintf(copy, sizeof copy, "%s/vfcapture-poses-XXXXXX.log", tmp && *tmp ? tmp : "/tmp");

@@ -6,11 +6,22 @@
 #include "cli.h"
 
 static const cli_command commands[] = {
+    {"run", cmd_run, "the whole pipeline on one capture: ingest, poses, train, attack, export"},
     {"ingest", cmd_ingest, "bring a capture into a workspace (video, photos, webcam or posed set)"},
     {"poses", cmd_poses, "camera poses by structure from motion (COLMAP), in the object frame"},
+    {"train", cmd_train, "fit a radiance field to the posed images (CPU, minutes)"},
+    {"render", cmd_render, "render the trained field from a viewpoint or camera pose"},
+    {"eval", cmd_eval, "PSNR/SSIM of the trained field on a posed test set"},
+    {"attack", cmd_attack, "ViewFool: adversarial viewpoint distribution on the trained field"},
+    {"transfer", cmd_transfer, "success rate of an attack's sampled viewpoints on other models"},
+    {"export", cmd_export, "target shots for the attack's viewpoints: poses, words, previews, card"},
+    {"localize", cmd_localize, "where was this frame taken? poses of new photos or video frames"},
+    {"reshoot", cmd_reshoot, "guided capture at a target: live advice, saves frames on target"},
+    {"score", cmd_score, "physical attack success rate from a re-captured video"},
     {"classify", cmd_classify, "classify images with an ImageNet model, print top-5"},
     {"benchmark", cmd_benchmark, "ImageNet-V style set from attacked objects; score classifiers"},
     {"info", cmd_info, "show a workspace's stages, parameters and outputs"},
+    {"calib", cmd_calib, "camera calibration (checkerboard) and a workspace's metric scale"},
 };
 static const int command_count = sizeof commands / sizeof commands[0];
 

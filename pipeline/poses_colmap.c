@@ -162,10 +162,14 @@ vf_status poses_map(poses_run *run)
     vf_status status = vf_path_join(sparse, sizeof sparse, run->scratch, "sparse");
     if (status == VF_OK)
         status = vf_mkdirs(sparse);
-    if (status == VF_OK)
-        status = run_mapper(run, sparse);
     if (status != VF_OK)
         return status;
+    /* The mapper exits 1 ("failed to create sparse model") when no pair of frames starts a
+     * model: the input's fault, which the registration check reports (0 registered). */
+    status = run_mapper(run, sparse);
+    if (status != VF_OK && run->colmap.last_exit != 1)
+        return status;
+    status = VF_OK;
     DIR *dir = opendir(sparse);
     if (!dir)
         return vf_fail(VF_EINTERNAL, "cannot open %s: %s", sparse, strerror(errno));

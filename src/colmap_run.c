@@ -183,6 +183,7 @@ static void follow_output(vf_colmap *colmap, int fd, vf_progress *progress, char
 vf_status vf_colmap_run(vf_colmap *colmap, const char *label, size_t total, const vf_args *args,
                         double *seconds)
 {
+    colmap->last_exit = -1;
     if (args->count == 0 || args->items[args->count] != NULL)
         return vf_fail(VF_EINTERNAL, "out of memory building the COLMAP command line");
     fprintf(colmap->log, "\n$ colmap");
@@ -217,7 +218,9 @@ vf_status vf_colmap_run(vf_colmap *colmap, const char *label, size_t total, cons
     fflush(colmap->log);
     if (seconds)
         *seconds = elapsed;
-    if (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0)
+    if (WIFEXITED(wstatus))
+        colmap->last_exit = WEXITSTATUS(wstatus);
+    if (colmap->last_exit == 0)
         return VF_OK;
     char how[64];
     if (WIFSIGNALED(wstatus))

@@ -61,21 +61,24 @@ static void draw(vf_progress *p, int final)
     double fraction = p->total ? (double)p->done / (double)p->total : 1.0;
     const char *sep = p->note[0] ? "  " : "";
 
+    /* Without a unit (work measured as a fraction) only the share done and the time show. */
+    char counts[96] = "";
+    if (p->unit[0])
+        snprintf(counts, sizeof counts, "%zu/%zu %s, %.1f %s/s, ", p->done, p->total, p->unit, rate,
+                 p->unit);
     if (p->on_terminal) {
         char bar[26];
         int filled = (int)(fraction * 24 + 0.5);
         for (int i = 0; i < 24; i++)
             bar[i] = i < filled ? '#' : '.';
         bar[24] = '\0';
-        fprintf(stderr, "\r\033[K%s [%s] %zu/%zu %s  %.1f %s/s  %s %s%s%s", p->label, bar, p->done,
-                p->total, p->unit, rate, p->unit, final ? "took" : "eta",
-                final ? elapsed_text : eta_text, sep, p->note);
+        fprintf(stderr, "\r\033[K%s [%s] %3.0f%%  %s%s %s%s%s", p->label, bar, 100.0 * fraction,
+                counts, final ? "took" : "eta", final ? elapsed_text : eta_text, sep, p->note);
         if (final)
             fputc('\n', stderr);
     } else {
-        fprintf(stderr, "%s: %zu/%zu %s (%3.0f%%), %.1f %s/s, %s %s%s%s\n", p->label, p->done,
-                p->total, p->unit, 100.0 * fraction, rate, p->unit, final ? "took" : "eta",
-                final ? elapsed_text : eta_text, sep, p->note);
+        fprintf(stderr, "%s: %3.0f%%, %s%s %s%s%s\n", p->label, 100.0 * fraction, counts,
+                final ? "took" : "eta", final ? elapsed_text : eta_text, sep, p->note);
     }
     fflush(stderr);
     p->last_draw = vf_now();

@@ -102,16 +102,11 @@ static vf_status load_attack(const vf_workspace *ws, vbench_object *o)
     return status;
 }
 
-/* The cameras the field was trained on: the undistorted poses, or an imported posed set. */
+/* The cameras the field was trained on. */
 static vf_status load_natural_views(const vf_workspace *ws, vf_dataset *out)
 {
     char path[VF_PATH_MAX];
-    vf_status status = vf_workspace_path(ws, "poses", "transforms_undistorted.json", path,
-                                         sizeof path);
-    if (status == VF_OK && !vf_is_file(path))
-        status = vf_workspace_path(ws, "ingest", "transforms.json", path, sizeof path);
-    if (status == VF_OK && !vf_is_file(path))
-        return vf_fail(VF_EINPUT, "%s has no posed training views", ws->root);
+    vf_status status = vf_workspace_training_views(ws, path, sizeof path, NULL);
     return status == VF_OK ? vf_dataset_load(path, out) : status;
 }
 

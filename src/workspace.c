@@ -112,7 +112,25 @@ vf_status vf_workspace_path(const vf_workspace *ws, const char *stage, const cha
     return VF_OK;
 }
 
-vf_status vf_stage_begin(vf_workspace *ws, const char *stage, vf_stage *s)
+vf_status vf_workspace_training_views(const vf_workspace *ws, char *path, size_t size,
+                                      int *real_capture)
+{
+    int capture = vf_workspace_has_stage(ws, "poses");
+    vf_status status = capture ? vf_workspace_path(ws, "poses", "transforms_undistorted.json",
+                                                   path, size)
+                               : vf_workspace_path(ws, "ingest", "transforms.json", path, size);
+    if (status == VF_OK && capture && !vf_is_file(path)) /* poses --no-undistort */
+        status = vf_workspace_path(ws, "poses", "transforms.json", path, size);
+    if (status == VF_OK && !vf_is_file(path))
+        return vf_fail(VF_EINPUT, "%s has no posed images: run 'vfcapture poses %s' first (or "
+                                  "import a posed set with 'vfcapture ingest --transforms')",
+                       ws->root, ws->root);
+    if (real_capture)
+        *real_capture = capture;
+    return status;
+}
+
+static vf_status stage_start(vf_workspace *ws, const char *stage, int keep, vf_stage *s)
 {
     memset(s, 0, sizeof *s);
     s->ws = ws;
@@ -120,10 +138,21 @@ vf_status vf_stage_begin(vf_workspace *ws, const char *stage, vf_stage *s)
     snprintf(s->name, sizeof s->name, "%s", stage);
     if (snprintf(s->dir, sizeof s->dir, "%s/.%s.partial", ws->root, stage) >= (int)sizeof s->dir)
         return vf_fail(VF_EINPUT, "workspace path too long: %s", ws->root);
-    vf_status status = vf_remove_tree(s->dir); /* left over from an interrupted run */
+    /* What an interrupted run left: thrown away unless resuming. */
+    vf_status status = keep ? VF_OK : vf_remove_tree(s->dir);
     if (status == VF_OK)
         status = vf_mkdirs(s->dir);
     return status;
+}
+
+vf_status vf_stage_begin(vf_workspace *ws, const char *stage, vf_stage *s)
+{
+    return stage_start(ws, stage, 0, s);
+}
+
+vf_status vf_stage_resume(vf_workspace *ws, const char *stage, vf_stage *s)
+{
+    return stage_start(ws, stage, 1, s);
 }
 
 static void utc_timestamp(char *out, size_t size)

@@ -1,9 +1,10 @@
-/* tests/poses_helpers.h: what the poses tests share (header-only, static functions).
+/* tests/poses_helpers.h: what the poses tests share (header-only, static inline functions).
  *
  * make_ingested_workspace() builds a workspace whose ingest stage holds a folder's images,
  * through the workspace API, as ingest would leave it. run_poses() runs `vfcapture poses` (the
  * tool from $VF_TOOL) with stdout and stderr in files and returns its exit code and wall time.
- * load_json() reads a JSON document. */
+ * load_json() reads a JSON document. compare_poses() measures how far poses are from reference
+ * poses after a similarity alignment of the camera centres. */
 #ifndef VF_TEST_POSES_HELPERS_H
 #define VF_TEST_POSES_HELPERS_H
 
@@ -14,10 +15,11 @@
 
 #include "check.h"
 #include "vf/log.h"
+#include "vf/pose.h"
 #include "vf/workspace.h"
 
 /* Copy every .jpg/.png of `images` (at most `limit`, 0: all) into a new workspace at `ws`. */
-static int make_ingested_workspace(const char *ws, const char *images, int limit)
+static inline int make_ingested_workspace(const char *ws, const char *images, int limit)
 {
     vf_workspace w;
     vf_stage stage;
@@ -47,7 +49,7 @@ static int make_ingested_workspace(const char *ws, const char *images, int limit
 }
 
 /* Run `$VF_TOOL poses WS ARGS >out 2>err`; *seconds gets the wall time. */
-static int run_poses(const char *ws, const char *args, const char *out, const char *err,
+static inline int run_poses(const char *ws, const char *args, const char *out, const char *err,
                      double *seconds)
 {
     const char *tool = getenv("VF_TOOL");
@@ -59,26 +61,67 @@ static int run_poses(const char *ws, const char *args, const char *out, const ch
     return rc;
 }
 
-static json_t *load_json(const char *path)
+static inline json_t *load_json(const char *path)
 {
     json_error_t e;
     return json_load_file(path, 0, &e);
 }
 
-static int compare_double(const void *a, const void *b)
+static inline int compare_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
 }
 
 /* The q-quantile (0..1) of n values (sorts them). */
-static double quantile(double *v, int n, double q)
+static inline double quantile(double *v, int n, double q)
 {
     if (n == 0)
         return NAN;
     qsort(v, (size_t)n, sizeof *v, compare_double);
     int i = (int)(q * (n - 1) + 0.5);
     return v[i];
+}
+
+typedef struct pose_errors {
+    double rot_median, rot_p90; /* degrees */
+    double pos_median, pos_p90; /* share of the mean camera distance (4 in the object frame) */
+} pose_errors;
+
+/* Align the reference c2w matrices (OpenGL axes) onto ours (Umeyama on the camera centres)
+ * and measure per camera the rotation error (degrees) and the position error (share of
+ * `distance`, our mean camera distance). ours[i] and ref[i] are the same photo. */
+static inline pose_errors compare_poses(const double *const *ours, const double *const *ref,
+                                        int n, double distance)
+{
+    pose_errors e = {NAN, NAN, NAN, NAN};
+    double *src = malloc(sizeof(double) * 3 * n), *dst = malloc(sizeof(double) * 3 * n);
+    double *rot = malloc(sizeof(double) * n), *pos = malloc(sizeof(double) * n);
+    vf_similarity align;
+    for (int i = 0; i < n; i++) {
+        vf_mat4_translation(ref[i], src + 3 * i);
+        vf_mat4_translation(ours[i], dst + 3 * i);
+    }
+    if (vf_similarity_umeyama(src, dst, n, &align) == VF_OK) {
+        for (int i = 0; i < n; i++) {
+            double moved[16], r_ours[9], r_ref[9], p[3], d2 = 0;
+            vf_similarity_apply_c2w(&align, ref[i], moved);
+            vf_mat4_rotation(moved, r_ref);
+            vf_mat4_rotation(ours[i], r_ours);
+            rot[i] = vf_rot_angle_deg(r_ours, r_ref);
+            vf_mat4_translation(moved, p);
+            for (int k = 0; k < 3; k++)
+                d2 += (p[k] - dst[3 * i + k]) * (p[k] - dst[3 * i + k]);
+            pos[i] = sqrt(d2) / distance;
+        }
+        e = (pose_errors){quantile(rot, n, 0.5), quantile(rot, n, 0.9), quantile(pos, n, 0.5),
+                          quantile(pos, n, 0.9)};
+    }
+    free(src);
+    free(dst);
+    free(rot);
+    free(pos);
+    return e;
 }
 
 #endif

@@ -146,15 +146,18 @@ static void test_runner(const char *dir)
     CHECK(vf_colmap_run(&colmap, "test", 2, &args, &seconds) == VF_OK, "ok run: %s",
           vf_error_message());
     CHECK(seconds >= 0, "wall time");
+    CHECK(colmap.last_exit == 0, "exit code 0 kept");
 
     make_script(script, "exit 3");
     CHECK(vf_colmap_run(&colmap, "test", 2, &args, NULL) == VF_EINTERNAL, "failing program");
     CHECK(strstr(vf_error_message(), "feature_extractor failed (exit 3)") &&
               strstr(vf_error_message(), "the disk is on fire"),
           "message: %s", vf_error_message());
+    CHECK(colmap.last_exit == 3, "exit code kept (%d)", colmap.last_exit);
 
     make_script(script, "kill -SEGV $$");
     CHECK(vf_colmap_run(&colmap, "test", 2, &args, NULL) == VF_EINTERNAL, "crashing program");
+    CHECK(colmap.last_exit == -1, "a crash has no exit code (%d)", colmap.last_exit);
     CHECK(strstr(vf_error_message(), "crashed") != NULL, "message: %s", vf_error_message());
     vf_colmap_close(&colmap);
 

@@ -28,7 +28,8 @@ typedef struct vf_args {
 
 /* Append one argument (copied). Out-of-memory is remembered and reported by vf_colmap_run. */
 void vf_args_add(vf_args *args, const char *item);
-/* Append "--name" and its formatted value, e.g. vf_args_opt(a, "--Mapper.ba_refine_focal_length", "%d", 0). */
+/* Append "--name" and its formatted value,
+ * e.g. vf_args_opt(a, "--Mapper.ba_refine_focal_length", "%d", 0). */
 void vf_args_opt(vf_args *args, const char *name, const char *fmt, ...)
 #ifdef __GNUC__
     __attribute__((format(printf, 3, 4)))
@@ -40,6 +41,7 @@ typedef struct vf_colmap {
     char program[VF_PATH_MAX]; /* resolved path of the colmap executable */
     char log_path[VF_PATH_MAX];
     FILE *log;
+    int last_exit; /* exit code of the last run; -1 when it crashed or could not start */
 } vf_colmap;
 
 /* Find the colmap executable ($VF_COLMAP, else PATH) and open (truncate) the log file.
@@ -49,8 +51,9 @@ void vf_colmap_close(vf_colmap *colmap);
 
 /* Run `colmap args...` (args->items[0] is the COLMAP command, e.g. "feature_extractor") and
  * wait for it. Its output goes to the log; `label` names the progress line, sized for `total`
- * units (images; NULL label: no progress line), and `seconds` (may be NULL) receives the wall time. A nonzero exit or a crash
- * is VF_EINTERNAL, quoting COLMAP's last error line. */
+ * units (images; NULL label: no progress line), and `seconds` (may be NULL) receives the wall
+ * time. A nonzero exit or a crash is VF_EINTERNAL, quoting COLMAP's last error line;
+ * colmap->last_exit (the exit code, -1 for a crash) tells them apart. */
 vf_status vf_colmap_run(vf_colmap *colmap, const char *label, size_t total, const vf_args *args,
                         double *seconds);
 

@@ -36,6 +36,7 @@
 #ifndef VF_FIELD_H
 #define VF_FIELD_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "vf/camera.h"

@@ -45,7 +45,18 @@ json_t *vf_workspace_stage_record(const vf_workspace *ws, const char *stage);
 vf_status vf_workspace_path(const vf_workspace *ws, const char *stage, const char *file, char *out,
                             size_t size);
 
+/* The transforms file of the posed training views: a capture's undistorted frames
+ * (WS/poses/transforms_undistorted.json, or transforms.json with the lens when they were not
+ * undistorted; *real_capture = 1) or an imported posed set
+ * (WS/ingest/transforms.json, *real_capture = 0; real_capture may be NULL). VF_EINPUT saying
+ * what to run first when there is neither. */
+vf_status vf_workspace_training_views(const vf_workspace *ws, char *path, size_t size,
+                                      int *real_capture);
+
 vf_status vf_stage_begin(vf_workspace *ws, const char *stage, vf_stage *s);
+/* Like vf_stage_begin, but keep what an interrupted run left in the staging folder (a stage
+ * that checkpoints there continues from it); the folder is created when missing. */
+vf_status vf_stage_resume(vf_workspace *ws, const char *stage, vf_stage *s);
 /* Swap the staging folder in and record params and summary (both stolen; either may be NULL). */
 vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary);
 void vf_stage_abort(vf_stage *s);

@@ -67,6 +67,10 @@ void field_grid_fill_occupancy(field_grid *g)
     size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2];
     memset(g->cell_bits, 0xff, bit_words(cells) * sizeof(uint64_t));
     memset(g->block_bits, 1, (size_t)g->blocks[0] * g->blocks[1] * g->blocks[2]);
+    for (int a = 0; a < 3; a++) {
+        g->occ_lo[a] = 0;
+        g->occ_hi[a] = g->cells[a];
+    }
 }
 
 size_t field_grid_occupied_cells(const field_grid *g)
@@ -121,8 +125,7 @@ vf_status field_grid_resample(const field_grid *src, float voxel, field_grid *ou
     return VF_OK;
 }
 
-/* alpha >= threshold  <=>  d >= the raw density this returns (softplus is monotonic). */
-static float density_threshold(const vf_field *f, float threshold, float step_world)
+float field_density_threshold(const vf_field *f, float threshold, float step_world)
 {
     /* alpha = 1 - exp(-softplus(d + shift) * scale * step) */
     float sigma = -logf(1.0f - threshold) / (f->density_scale * step_world);
@@ -132,7 +135,7 @@ static float density_threshold(const vf_field *f, float threshold, float step_wo
 
 void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_world)
 {
-    float d_min = density_threshold(f, f->occupancy_alpha, step_world);
+    float d_min = field_density_threshold(f, f->occupancy_alpha, step_world);
     size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2];
     size_t blocks = (size_t)g->blocks[0] * g->blocks[1] * g->blocks[2];
     uint8_t *point_on = malloc(g->points);
@@ -163,11 +166,20 @@ void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_wo
         g->cell_bits[w] = word;
     }
     free(point_on);
+    for (int a = 0; a < 3; a++) {
+        g->occ_lo[a] = g->cells[a];
+        g->occ_hi[a] = 0;
+    }
     for (int z = 0; z < cz; z++)
         for (int y = 0; y < cy; y++)
             for (int x = 0; x < cx; x++) {
                 size_t c = (size_t)x + (size_t)cx * ((size_t)y + (size_t)cy * z);
                 if (field_cell_occupied(g, c)) {
+                    const int at[3] = {x, y, z};
+                    for (int a = 0; a < 3; a++) {
+                        g->occ_lo[a] = at[a] < g->occ_lo[a] ? at[a] : g->occ_lo[a];
+                        g->occ_hi[a] = at[a] + 1 > g->occ_hi[a] ? at[a] + 1 : g->occ_hi[a];
+                    }
                     size_t b = (size_t)(x >> FIELD_BLOCK_SHIFT) +
                                (size_t)g->blocks[0] * ((size_t)(y >> FIELD_BLOCK_SHIFT) +
                                                        (size_t)g->blocks[1] * (z >> FIELD_BLOCK_SHIFT));

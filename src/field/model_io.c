@@ -311,6 +311,10 @@ vf_status vf_field_load(const char *path, vf_field **out)
         vf_field_free(f);
         return status;
     }
+    /* A loaded field is only rendered, and rendering skips samples under FIELD_VISIBLE_ALPHA:
+     * a cell whose corners all stay under it holds no visible sample (values inside are
+     * trilinear), so marking it empty skips more and changes no pixel. */
+    f->occupancy_alpha = fmaxf(f->occupancy_alpha, FIELD_VISIBLE_ALPHA);
     refresh_occupancy(f);
     *out = f;
     return VF_OK;

@@ -53,13 +53,15 @@ static void render_rows(const vf_field *f, const vf_camera *cam, const double c2
                         float *depth, float *opacity, int parallel)
 {
     const int width = cam->width, height = cam->height;
+    field_render_setup setup;
+    field_render_setup_init(f, &setup);
 #pragma omp parallel for schedule(dynamic, 2) if (parallel)
     for (int y = 0; y < height; y++) {
         for (int x = 0; x < width; x++) {
             field_ray ray;
             field_march_result res;
             field_camera_ray(cam, c2w, x + 0.5, y + 0.5, &ray);
-            field_march(f, &ray, 0.5f, f->stop_transmittance, NULL, &res);
+            field_render_ray(f, &setup, &ray, 0.5f, f->stop_transmittance, &res);
             size_t i = (size_t)y * width + x;
             if (rgb)
                 memcpy(rgb + 3 * i, res.rgb, sizeof res.rgb);

@@ -1,0 +1,186 @@
+/* vf/calib.h: camera calibration from a checkerboard, and metric scale for a workspace.
+ *
+ * Intrinsics: frames that show a planar checkerboard of known square size are searched for its
+ * inner corners (OpenCV, src/opencv/calib_cv.cpp); well-spread views are kept; OpenCV's
+ * calibrateCamera gives the first estimate of the OPENCV lens (fx, fy, cx, cy, k1, k2, p1, p2,
+ * as COLMAP and vf/camera.h use it); views that reproject badly are dropped; Ceres then refines
+ * lens and board poses together under a robust (Huber) loss (src/ceres/calib_refine.cpp).
+ * Pixel coordinates follow vf/camera.h: the image corner is (0, 0), pixel centres at +0.5.
+ *
+ * Scale: a workspace's scene units (object frame of WS/poses/transforms.json) are tied to
+ * metres by triangulating points of known separation over posed frames: the four corners of
+ * a printed ArUco marker (the original ArUco dictionary, 1024 ids, OpenCV's
+ * DICT_ARUCO_ORIGINAL) or two points a person picked in two or more frames each. The factor is
+ * kept in WS/calib/scale.json; vf_workspace_metres_per_unit() reads it for other commands.
+ *
+ * Memory: structs filled here own their arrays and are released with their _free function;
+ * images are the caller's. */
+#ifndef VF_CALIB_H
+#define VF_CALIB_H
+
+#include <jansson.h>
+
+#include "vf/camera.h"
+#include "vf/error.h"
+#include "vf/rgb8.h"
+#include "vf/v4l2.h"
+#include "vf/workspace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- the checkerboard ---- */
+
+typedef struct vf_calib_board {
+    int cols, rows; /* inner corners (where four squares meet): a 10 x 7 squares board is 9 x 6 */
+    double square;  /* side of one square, in the unit the poses should have (metres) */
+} vf_calib_board;
+
+/* Inner-corner count of a board: cols * rows. */
+int vf_calib_board_corners(const vf_calib_board *board);
+
+/* A printable board: (cols + 1) x (rows + 1) squares of square_px pixels, top-left square
+ * black, with a white margin of one square all round. */
+vf_status vf_calib_board_image(const vf_calib_board *board, int square_px, vf_rgb8 *out);
+
+/* Find the board's inner corners in a frame. *found is 1 when all of them were seen, and uv
+ * (2 * cols * rows doubles, row by row) then holds their subpixel positions. */
+vf_status vf_calib_find_board(const vf_rgb8 *frame, const vf_calib_board *board, double *uv,
+                              int *found);
+
+/* ---- intrinsics ---- */
+
+/* One frame in which the board was found. */
+typedef struct vf_calib_view {
+    char name[128]; /* where it came from: a file name or "frame 123" */
+    double *uv;     /* 2 * corners pixel positions (owned) */
+    double rms;     /* reprojection error of this view after calibration, pixels (0 unused) */
+    int state;      /* VF_VIEW_* below */
+} vf_calib_view;
+
+enum {
+    VF_VIEW_SPARE = 0,   /* found, but too close to views already kept */
+    VF_VIEW_USED = 1,    /* in the final calibration */
+    VF_VIEW_OUTLIER = 2, /* dropped: reprojected much worse than the others */
+};
+
+typedef struct vf_calib_views {
+    int width, height; /* frame size (every frame must have it) */
+    int count, capacity;
+    vf_calib_view *views;
+    int frames_seen;   /* frames searched, with or without a board */
+} vf_calib_views;
+
+/* Add a found board (uv is copied). The first call fixes the frame size. */
+vf_status vf_calib_views_add(vf_calib_views *set, int width, int height, const char *name,
+                             const double *uv, int corners);
+void vf_calib_views_free(vf_calib_views *set);
+
+/* Search frames for the board and add every view it is found in. A folder: its .jpg, .jpeg
+ * and .png files in name order (searched in parallel). A video: at most max_frames frames,
+ * spread evenly over it. A V4L2 webcam: every frame it delivers for `seconds` (ops NULL: the
+ * real device). Progress goes to stderr. */
+vf_status vf_calib_collect_folder(const char *folder, const vf_calib_board *board,
+                                  vf_calib_views *out);
+vf_status vf_calib_collect_video(const char *path, const vf_calib_board *board, int max_frames,
+                                 vf_calib_views *out);
+vf_status vf_calib_collect_camera(const char *device, const vf_v4l2_ops *ops,
+                                  const vf_calib_board *board, double seconds,
+                                  vf_calib_views *out);
+
+typedef struct vf_calib_options {
+    int max_views;         /* well-spread views to calibrate with (default 40) */
+    int min_views;         /* fewer found boards than this is an input error (default 6) */
+    double outlier_factor; /* a view is an outlier above this times the median view error,
+                              and above outlier_floor pixels (defaults 3 and 0.5) */
+    double outlier_floor;
+    double huber_px;       /* robust loss scale of the Ceres refinement (default 1 pixel) */
+} vf_calib_options;
+
+void vf_calib_defaults(vf_calib_options *opt);
+
+typedef struct vf_calib_result {
+    vf_camera camera;   /* the calibrated lens, for width x height frames */
+    double rms;         /* RMS reprojection error over the used views' corners, pixels */
+    double rms_opencv;  /* the same after OpenCV alone (before outlier removal and Ceres) */
+    int used, outliers; /* views calibrated with / dropped */
+    double seconds_opencv, seconds_ceres;
+} vf_calib_result;
+
+/* Calibrate from the found views: chooses views (marks them VF_VIEW_USED), drops outliers
+ * (VF_VIEW_OUTLIER), fills each used view's rms and the result. VF_EINPUT when fewer than
+ * opt->min_views boards were found, naming the board and what to try. */
+vf_status vf_calib_solve(vf_calib_views *set, const vf_calib_board *board,
+                         const vf_calib_options *opt, vf_calib_result *out);
+
+/* The camera file `poses --camera` reads: fl_x, fl_y, cx, cy, w, h, k1, k2, p1, p2, plus rms,
+ * views, the board and every view's error. Written atomically. */
+vf_status vf_calib_save_camera(const char *path, const vf_calib_result *res,
+                               const vf_calib_views *set, const vf_calib_board *board);
+
+/* ---- geometry shared by the calibration and its tests ---- */
+
+/* Render a textured plane through a lens: the texture lies on the plane z = 0 of its own
+ * frame, texel (i, j) covering [i, i+1) x [j, j+1) * texel_size; rot/t map plane points into
+ * the camera (OpenCV axes: x_cam = rot * x_plane + t). Pixels that miss the texture get
+ * `background`. supersample (1..4) renders larger and shrinks, against aliasing. */
+vf_status vf_calib_render_plane(const vf_camera *cam, const double rot[9], const double t[3],
+                                const vf_rgb8 *texture, double texel_size,
+                                unsigned char background, int supersample, vf_rgb8 *out);
+
+/* The point nearest (least squares) to n >= 2 rays origin[i] + s dir[i] (dir unit length).
+ * VF_EINPUT when the rays are (nearly) parallel, so depth is not determined. */
+vf_status vf_triangulate_rays(const double *origin, const double *dir, int n, double out[3]);
+
+/* ---- ArUco markers (original dictionary) ---- */
+
+#define VF_ARUCO_IDS 1024
+
+/* A printable marker: 7 x 7 cells (black border, 5 x 5 code) of cell_px pixels, inside a white
+ * margin of one cell. The marker's side (what --size measures) is the black square, 7 cells. */
+vf_status vf_aruco_image(int id, int cell_px, vf_rgb8 *out);
+
+/* The id coded by a 5 x 5 bit grid (row by row, 1 = white) read in the marker's own
+ * orientation, or -1 when it is not a valid code. */
+int vf_aruco_decode(const unsigned char bits[25]);
+
+typedef struct vf_marker {
+    int id;
+    double corners[8]; /* (u, v) of the marker's top-left, top-right, bottom-right and
+                          bottom-left corners as printed, subpixel */
+} vf_marker;
+
+/* Find the ArUco markers in a frame (at most max; *count gets how many were stored). */
+vf_status vf_aruco_detect(const vf_rgb8 *frame, vf_marker *markers, int max, int *count);
+
+/* ---- metric scale of a workspace ---- */
+
+/* Where one point was seen: a frame (its image file name, with or without the extension)
+ * and the pixel, in that image as stored. */
+typedef struct vf_pick {
+    char frame[128];
+    double u, v;
+} vf_pick;
+
+/* Parse "NAME:U,V;NAME:U,V[;...]" (at least two picks) into picks; *count gets how many. */
+vf_status vf_parse_picks(const char *text, vf_pick *picks, int max, int *count);
+
+/* Scale from a marker of side size_m metres seen in the posed frames of the workspace
+ * (WS/poses/transforms.json, else a posed import's WS/ingest/transforms.json). *details
+ * (a new JSON object) says which frames saw it, the triangulated corners and side lengths. */
+vf_status vf_scale_from_marker(const vf_workspace *ws, int id, double size_m,
+                               double *metres_per_unit, json_t **details);
+
+/* Scale from two points picked in the frames (each in at least two) and their distance. */
+vf_status vf_scale_from_picks(const vf_workspace *ws, const vf_pick *p1, int n1,
+                              const vf_pick *p2, int n2, double distance_m,
+                              double *metres_per_unit, json_t **details);
+
+/* Whether the workspace has a metric scale (WS/calib/scale.json); *metres_per_unit gets it. */
+int vf_workspace_metres_per_unit(const vf_workspace *ws, double *metres_per_unit);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

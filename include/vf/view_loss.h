@@ -1,0 +1,87 @@
+/* vf/view_loss.h: what a classifier makes of a radiance field seen from given viewpoints.
+ *
+ * The attack's objective in one object: render a batch of ViewFool viewpoints (or camera
+ * poses) of a field with the classifier camera (the S x S crop a classifier sees of a training
+ * photo, vf_field_classifier_camera), normalize, classify the batch, and score it against a
+ * true label set. Everything stays in memory: no files in the loop. The loss of a view is
+ * the cross-entropy of the label set,
+ *
+ *     L(v) = -log( sum over y in the set of p_y(R(v)) ),
+ *
+ * and the view fools the classifier when its top-1 class is outside the set. Rendering and
+ * classification use every core; buffers are allocated once, for VF_VIEW_LOSS_CHUNK views,
+ * so memory stays flat whatever the batch size.
+ *
+ * Threads: one vf_view_loss is used by one thread at a time (it owns scratch buffers and
+ * borrows a classifier, which is not re-entrant). Memory: the field and classifier are
+ * borrowed and must outlive it; free it with vf_view_loss_free. */
+#ifndef VF_VIEW_LOSS_H
+#define VF_VIEW_LOSS_H
+
+#include <stddef.h> /* vf/field.h uses size_t without including it */
+
+#include "vf/camera.h"
+#include "vf/classifier.h"
+#include "vf/error.h"
+#include "vf/field.h"
+#include "vf/image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define VF_VIEW_LOSS_CHUNK 16   /* views rendered and classified together */
+#define VF_MAX_LABELS 32        /* classes in one label set */
+#define VF_VIEW_LOSS_FLOOR 1e-30 /* label-set probability floor: losses stay finite (<= 69) */
+
+typedef struct vf_view_prediction {
+    int top_class;    /* top-1 ImageNet class */
+    float top_prob;   /* its probability */
+    float label_prob; /* total probability of the label set (0 before labels are set) */
+    int correct;      /* top_class is in the label set */
+} vf_view_prediction;
+
+/* Time spent so far, for reports and benchmarks. */
+typedef struct vf_view_loss_stats {
+    long views;             /* views rendered and classified */
+    double render_seconds;  /* wall time in the renderer */
+    double classify_seconds; /* wall time normalizing and in the network */
+} vf_view_loss_stats;
+
+typedef struct vf_view_loss vf_view_loss;
+
+/* Borrow field and classifier; the camera is the classifier camera for the model's input size. */
+vf_status vf_view_loss_create(const vf_field *field, vf_classifier *cls, vf_view_loss **out);
+void vf_view_loss_free(vf_view_loss *vl);
+
+/* Set the true label set (1..VF_MAX_LABELS ImageNet classes). */
+vf_status vf_view_loss_set_labels(vf_view_loss *vl, const int *labels, int count);
+
+vf_camera vf_view_loss_camera(const vf_view_loss *vl);
+vf_view_loss_stats vf_view_loss_get_stats(const vf_view_loss *vl);
+
+/* Classify n views: viewpoints (n x 6: psi, theta, phi degrees, dx, dy, dz) or camera poses
+ * (n row-major 4x4 camera-to-world matrices, OpenGL axes). out gets n predictions; losses
+ * (may be NULL) n losses. */
+vf_status vf_view_loss_classify(vf_view_loss *vl, const double *views, int n,
+                                vf_view_prediction *out, double *losses);
+vf_status vf_view_loss_classify_poses(vf_view_loss *vl, const double *c2w, int n,
+                                      vf_view_prediction *out);
+
+/* The attack's loss callback (vf/viewfool.h, vf_attack_loss_fn); ctx is a vf_view_loss with
+ * its labels set. */
+vf_status vf_view_loss_fn(const double *views, int n, double *losses, int *fooled, void *ctx);
+
+/* -log(max(label_prob, VF_VIEW_LOSS_FLOOR)). */
+double vf_view_loss_of(double label_prob);
+
+/* Render one viewpoint with the classifier camera into out (allocated as vf_field_render). */
+vf_status vf_view_loss_render(const vf_view_loss *vl, const double view[6], vf_image *out);
+
+/* The class most views predict (ties: the smaller index) and how many predict it. */
+int vf_majority_class(const vf_view_prediction *pred, int n, int *votes);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,150 @@
+/* vfcapture calib: camera calibration (intrinsics from a checkerboard), a workspace's metric
+ * scale, and the printable board and markers they need. Dispatches to calib_intrinsics.c and
+ * calib_scale.c; the printouts are here. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "calib_cmd.h"
+#include "vf/log.h"
+
+static const char usage[] =
+    "usage: vfcapture calib <intrinsics|scale|board|marker> [options]\n"
+    "\n"
+    "  intrinsics (VIDEO | DIR | --v4l2 DEV) --board COLSxROWS --square MM [-o camera.json]\n"
+    "             calibrate a camera from views of a checkerboard; the camera file feeds\n"
+    "             'vfcapture poses --camera'\n"
+    "  scale WS (--marker ID --size MM | --distance P1 P2 MM)\n"
+    "             give a posed workspace metric scale (WS/calib/scale.json)\n"
+    "  board --board COLSxROWS -o board.png [--square-px N]\n"
+    "             write a printable checkerboard\n"
+    "  marker --id ID -o marker.png [--cell-px N]\n"
+    "             write a printable ArUco marker (original dictionary, ids 0..1023)\n"
+    "\n"
+    "'vfcapture calib <subcommand> --help' for details.\n";
+
+vf_status calib_parse_board(const char *text, vf_calib_board *board)
+{
+    char *end;
+    long cols = strtol(text, &end, 10), rows = 0;
+    if (*end == 'x' || *end == 'X') {
+        const char *second = end + 1;
+        rows = strtol(second, &end, 10);
+        if (end == second)
+            rows = 0;
+    }
+    if (*end || cols < 2 || rows < 2 || cols > 100 || rows > 100)
+        return vf_fail(VF_EINPUT, "--board: give the inner corners as COLSxROWS, e.g. 9x6 for a "
+                                  "board of 10 x 7 squares");
+    board->cols = (int)cols;
+    board->rows = (int)rows;
+    return VF_OK;
+}
+
+vf_status calib_parse_mm(const char *text, const char *what, double *metres)
+{
+    double mm;
+    if (cli_parse_doubles(text, &mm, 1) != 1 || !(mm > 0) || mm > 1e6)
+        return vf_fail(VF_EINPUT, "%s: give a length in millimetres, e.g. 25", what);
+    *metres = mm / 1000.0;
+    return VF_OK;
+}
+
+enum { OPT_BOARD = CLI_OPT_FIRST_CUSTOM, OPT_ID, OPT_PX };
+
+/* `calib board` and `calib marker`: write a printable pattern. */
+static int print_pattern(int argc, char **argv, int marker)
+{
+    const char *name = marker ? "calib marker" : "calib board";
+    const char *help = marker
+                           ? "usage: vfcapture calib marker --id ID -o FILE.png [--cell-px N]\n"
+                             "\n"
+                             "Write ArUco marker ID (original dictionary, 0..1023; OpenCV's\n"
+                             "DICT_ARUCO_ORIGINAL) as a PNG: 7 x 7 cells with a white margin.\n"
+                             "Print it flat; its size for 'calib scale --size' is the side of\n"
+                             "the black square.\n"
+                             "\n"
+                             "options:\n"
+                             "      --id ID       the marker's id\n"
+                             "  -o, --output FILE the PNG to write\n"
+                             "      --cell-px N   pixels per cell (default 40)\n" CLI_COMMON_HELP
+                           : "usage: vfcapture calib board --board COLSxROWS -o FILE.png "
+                             "[--square-px N]\n"
+                             "\n"
+                             "Write a checkerboard with COLSxROWS inner corners ((COLS+1) x\n"
+                             "(ROWS+1) squares) as a PNG, with a white margin. Print it flat and\n"
+                             "measure one square for 'calib intrinsics --square'.\n"
+                             "\n"
+                             "options:\n"
+                             "      --board CxR   inner corners, e.g. 9x6\n"
+                             "  -o, --output FILE the PNG to write\n"
+                             "      --square-px N pixels per square (default 100)\n" CLI_COMMON_HELP;
+    static const struct option longopts[] = {
+        CLI_COMMON_OPTIONS,
+        {"board", required_argument, NULL, OPT_BOARD},
+        {"id", required_argument, NULL, OPT_ID},
+        {"square-px", required_argument, NULL, OPT_PX},
+        {"cell-px", required_argument, NULL, OPT_PX},
+        {"output", required_argument, NULL, 'o'},
+        {0, 0, 0, 0},
+    };
+    cli_flags flags = {0};
+    vf_calib_board board = {0, 0, 1};
+    const char *output = NULL;
+    long id = -1, px = marker ? 40 : 100;
+    int c;
+    vf_status status = VF_OK;
+    while (status == VF_OK &&
+           (c = getopt_long(argc, argv, CLI_COMMON_SHORT "o:", longopts, NULL)) != -1) {
+        if (cli_common_option(c, &flags, name, help))
+            continue;
+        if (c == 'o')
+            output = optarg;
+        else if (c == OPT_BOARD && !marker)
+            status = calib_parse_board(optarg, &board);
+        else if (c == OPT_ID && marker && cli_parse_int(optarg, 0, VF_ARUCO_IDS - 1, &id))
+            status = vf_fail(VF_EINPUT, "--id: give an id from 0 to %d", VF_ARUCO_IDS - 1);
+        else if (c == OPT_PX && cli_parse_int(optarg, 4, 1000, &px))
+            status = vf_fail(VF_EINPUT, "%s: give a number of pixels from 4 to 1000",
+                             marker ? "--cell-px" : "--square-px");
+        else if ((c == OPT_BOARD && marker) || (c == OPT_ID && !marker))
+            status = vf_fail(VF_EINPUT, "see 'vfcapture %s --help' for the options", name);
+    }
+    if (status == VF_OK && (optind != argc || !output))
+        status = vf_fail(VF_EINPUT, "give the output file with -o FILE.png (see 'vfcapture %s "
+                                    "--help')", name);
+    if (status == VF_OK && (marker ? id < 0 : board.cols == 0))
+        status = vf_fail(VF_EINPUT, marker ? "give the marker's --id" : "give --board COLSxROWS");
+    vf_rgb8 img = {0};
+    if (status == VF_OK)
+        status = marker ? vf_aruco_image((int)id, (int)px, &img)
+                        : vf_calib_board_image(&board, (int)px, &img);
+    if (status == VF_OK)
+        status = vf_rgb8_save(output, &img);
+    vf_rgb8_free(&img);
+    if (status != VF_OK)
+        return cli_fail(name, status);
+    if (flags.json)
+        cli_print_json(json_pack("{s:s}", "output", output));
+    else
+        vf_info("wrote %s", output);
+    return 0;
+}
+
+int cmd_calib(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
+        fputs(usage, argc < 2 ? stderr : stdout);
+        return argc < 2 ? 1 : 0;
+    }
+    const char *sub = argv[1];
+    if (!strcmp(sub, "intrinsics"))
+        return calib_intrinsics(argc - 1, argv + 1);
+    if (!strcmp(sub, "scale"))
+        return calib_scale(argc - 1, argv + 1);
+    if (!strcmp(sub, "board") || !strcmp(sub, "marker"))
+        return print_pattern(argc - 1, argv + 1, !strcmp(sub, "marker"));
+    fprintf(stderr, "vfcapture calib: error: unknown subcommand '%s': use intrinsics, scale, "
+                    "board or marker\n",
+            sub);
+    return 1;
+}

@@ -1,0 +1,132 @@
+/* Measuring an attack's answer: v*, samples of p*(v), fluctuation, wrong classes
+ * (vf/attack_eval.h). */
+#include "vf/attack_eval.h"
+
+#include <string.h>
+
+#include "vf/classifier.h"
+
+/* Stream offsets so the evaluation never reuses the optimizer's random numbers. */
+#define SAMPLE_STREAM 0x5a3c1e77d2b4f601ULL
+#define FLUCT_STREAM 0x0f1e2d3c4b5a6978ULL
+
+static double fooled_rate(const vf_view_prediction *pred, int n)
+{
+    int fooled = 0;
+    for (int i = 0; i < n; i++)
+        fooled += !pred[i].correct;
+    return n ? (double)fooled / n : 0.0;
+}
+
+static void count_wrong_classes(vf_attack_eval *ev)
+{
+    int votes[VF_NUM_CLASSES] = {0};
+    for (int i = 0; i < ev->sample_count; i++)
+        if (!ev->sample_pred[i].correct)
+            votes[ev->sample_pred[i].top_class]++;
+    ev->wrong_count = 0;
+    while (ev->wrong_count < VF_TOP_WRONG) {
+        int best = 0;
+        for (int c = 1; c < VF_NUM_CLASSES; c++)
+            if (votes[c] > votes[best])
+                best = c;
+        if (votes[best] == 0)
+            break;
+        ev->wrong_class[ev->wrong_count] = best;
+        ev->wrong_votes[ev->wrong_count++] = votes[best];
+        votes[best] = 0;
+    }
+}
+
+/* Everything after the samples and v* are in place. */
+static vf_status measure(vf_view_loss *vl, const vf_view_bounds *bounds, uint64_t seed,
+                         vf_attack_eval *ev)
+{
+    vf_status status = vf_view_loss_classify(vl, ev->v_star, 1, &ev->v_star_pred, NULL);
+    if (status == VF_OK)
+        status = vf_view_loss_classify(vl, ev->samples, ev->sample_count, ev->sample_pred, NULL);
+    if (status != VF_OK)
+        return status;
+    ev->asr_v_star = !ev->v_star_pred.correct;
+    ev->asr_samples = fooled_rate(ev->sample_pred, ev->sample_count);
+    vf_view_std(ev->samples, ev->sample_count, ev->sample_std);
+    count_wrong_classes(ev);
+
+    vf_rng rng;
+    vf_rng_seed(&rng, seed ^ FLUCT_STREAM);
+    double views[VF_FLUCT_SAMPLES * VF_VIEW_DIM];
+    vf_view_prediction pred[VF_FLUCT_SAMPLES];
+    for (int r = 1; r <= VF_FLUCT_LEVELS && status == VF_OK; r++) {
+        vf_view_fluctuation(bounds, ev->v_star, r, &rng, VF_FLUCT_SAMPLES, views);
+        status = vf_view_loss_classify(vl, views, VF_FLUCT_SAMPLES, pred, NULL);
+        ev->fluct_asr[r - 1] = fooled_rate(pred, VF_FLUCT_SAMPLES);
+    }
+    return status;
+}
+
+vf_status vf_attack_eval_distribution(vf_view_loss *vl, const vf_attack_state *st,
+                                      const vf_attack_config *cfg, uint64_t seed,
+                                      vf_attack_eval *out)
+{
+    memset(out, 0, sizeof *out);
+    vf_attack_best_view(st, cfg, out->v_star);
+    vf_rng rng;
+    vf_rng_seed(&rng, seed ^ SAMPLE_STREAM);
+    out->sample_count = VF_EVAL_SAMPLES;
+    vf_attack_sample_views(st, cfg, &rng, VF_EVAL_SAMPLES, out->samples);
+    return measure(vl, &cfg->bounds, seed, out);
+}
+
+vf_status vf_attack_eval_random(vf_view_loss *vl, const vf_view_bounds *bounds, uint64_t seed,
+                                vf_attack_eval *out)
+{
+    memset(out, 0, sizeof *out);
+    vf_random_search_result rs;
+    double losses[VF_EVAL_SAMPLES];
+    vf_status status = vf_attack_random_search(bounds, VF_EVAL_SAMPLES, seed ^ SAMPLE_STREAM,
+                                               vf_view_loss_fn, vl, out->samples, losses, &rs);
+    if (status != VF_OK)
+        return status;
+    out->sample_count = VF_EVAL_SAMPLES;
+    memcpy(out->v_star, rs.best_view, sizeof out->v_star);
+    return measure(vl, bounds, seed, out);
+}
+
+static json_t *doubles_json(const double *x, int n)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < n; i++)
+        json_array_append_new(a, json_real(x[i]));
+    return a;
+}
+
+json_t *vf_view_prediction_to_json(const vf_view_prediction *p)
+{
+    return json_pack("{s:i, s:s, s:f, s:f, s:b}", "class", p->top_class, "name",
+                     vf_class_short_name(p->top_class), "confidence", (double)p->top_prob,
+                     "label_probability", (double)p->label_prob, "fooled", !p->correct);
+}
+
+json_t *vf_attack_eval_to_json(const vf_attack_eval *ev)
+{
+    json_t *samples = json_array(), *preds = json_array(), *wrong = json_array();
+    for (int i = 0; i < ev->sample_count; i++) {
+        json_array_append_new(samples, doubles_json(ev->samples + VF_VIEW_DIM * i, VF_VIEW_DIM));
+        json_array_append_new(preds, vf_view_prediction_to_json(&ev->sample_pred[i]));
+    }
+    for (int i = 0; i < ev->wrong_count; i++)
+        json_array_append_new(wrong, json_pack("{s:i, s:s, s:i}", "class", ev->wrong_class[i],
+                                               "name", vf_class_short_name(ev->wrong_class[i]),
+                                               "count", ev->wrong_votes[i]));
+    double r[VF_FLUCT_LEVELS];
+    for (int i = 0; i < VF_FLUCT_LEVELS; i++)
+        r[i] = i + 1;
+    return json_pack("{s:o, s:o, s:f, s:o, s:o, s:f, s:o, s:{s:o, s:o, s:i}, s:o}", "v_star",
+                     doubles_json(ev->v_star, VF_VIEW_DIM), "v_star_prediction",
+                     vf_view_prediction_to_json(&ev->v_star_pred), "asr_v_star", ev->asr_v_star,
+                     "samples", samples, "sample_predictions", preds, "asr_samples",
+                     ev->asr_samples, "sample_std", doubles_json(ev->sample_std, VF_VIEW_DIM),
+                     "fluctuation", "r_percent", doubles_json(r, VF_FLUCT_LEVELS), "asr",
+                     doubles_json(ev->fluct_asr, VF_FLUCT_LEVELS), "samples_per_level",
+                     VF_FLUCT_SAMPLES, "top_wrong_classes", wrong);
+}

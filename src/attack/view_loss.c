@@ -1,0 +1,178 @@
+/* Render -> normalize -> classify -> score, a chunk of views at a time (vf/view_loss.h). */
+#include "vf/view_loss.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vf/log.h"
+#include "vf/pose.h"
+
+struct vf_view_loss {
+    const vf_field *field;
+    vf_classifier *cls;
+    vf_camera camera;
+    int size; /* model input side S */
+    int labels[VF_MAX_LABELS], label_count;
+    vf_image images[VF_VIEW_LOSS_CHUNK]; /* render targets, reused */
+    float *batch;                         /* chunk x 3 x S x S network input */
+    float *probs;                         /* chunk x 1000 */
+    vf_view_loss_stats stats;
+};
+
+vf_status vf_view_loss_create(const vf_field *field, vf_classifier *cls, vf_view_loss **out)
+{
+    vf_view_loss *vl = calloc(1, sizeof *vl);
+    if (!vl)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    vl->field = field;
+    vl->cls = cls;
+    vl->size = vf_classifier_input_size(cls);
+    vl->camera = vf_field_classifier_camera(field, vl->size);
+    size_t plane = (size_t)vl->size * (size_t)vl->size;
+    vl->batch = malloc(VF_VIEW_LOSS_CHUNK * 3 * plane * sizeof(float));
+    vl->probs = malloc(VF_VIEW_LOSS_CHUNK * VF_NUM_CLASSES * sizeof(float));
+    if (!vl->batch || !vl->probs) {
+        vf_view_loss_free(vl);
+        return vf_fail(VF_EINTERNAL, "out of memory for the classifier batch");
+    }
+    *out = vl;
+    return VF_OK;
+}
+
+void vf_view_loss_free(vf_view_loss *vl)
+{
+    if (!vl)
+        return;
+    for (int i = 0; i < VF_VIEW_LOSS_CHUNK; i++)
+        vf_image_free(&vl->images[i]);
+    free(vl->batch);
+    free(vl->probs);
+    free(vl);
+}
+
+vf_status vf_view_loss_set_labels(vf_view_loss *vl, const int *labels, int count)
+{
+    if (count < 1 || count > VF_MAX_LABELS)
+        return vf_fail(VF_EINPUT, "a label set holds 1 to %d classes, not %d", VF_MAX_LABELS,
+                       count);
+    for (int i = 0; i < count; i++)
+        if (labels[i] < 0 || labels[i] >= VF_NUM_CLASSES)
+            return vf_fail(VF_EINPUT, "label %d is not an ImageNet class (0..999)", labels[i]);
+    memcpy(vl->labels, labels, (size_t)count * sizeof *labels);
+    vl->label_count = count;
+    return VF_OK;
+}
+
+vf_camera vf_view_loss_camera(const vf_view_loss *vl) { return vl->camera; }
+
+vf_view_loss_stats vf_view_loss_get_stats(const vf_view_loss *vl) { return vl->stats; }
+
+double vf_view_loss_of(double label_prob)
+{
+    return -log(label_prob > VF_VIEW_LOSS_FLOOR ? label_prob : VF_VIEW_LOSS_FLOOR);
+}
+
+static void predict(const vf_view_loss *vl, const float *probs, vf_view_prediction *out)
+{
+    int top;
+    vf_topk(probs, 1, &top, &out->top_prob);
+    out->top_class = top;
+    double sum = 0.0;
+    out->correct = 0;
+    for (int i = 0; i < vl->label_count; i++) {
+        sum += probs[vl->labels[i]];
+        out->correct |= vl->labels[i] == top;
+    }
+    out->label_prob = (float)sum;
+}
+
+/* Classify the n (<= chunk) images already rendered into vl->images. */
+static vf_status classify_rendered(vf_view_loss *vl, int n, vf_view_prediction *out)
+{
+    double t0 = vf_now();
+    size_t stride = 3 * (size_t)vl->size * (size_t)vl->size;
+#pragma omp parallel for
+    for (int i = 0; i < n; i++)
+        vf_classifier_normalize(&vl->images[i], vl->batch + (size_t)i * stride);
+    vf_status status = vf_classifier_forward(vl->cls, vl->batch, n, vl->probs);
+    if (status != VF_OK)
+        return status;
+    for (int i = 0; i < n; i++)
+        predict(vl, vl->probs + (size_t)i * VF_NUM_CLASSES, &out[i]);
+    vl->stats.classify_seconds += vf_now() - t0;
+    vl->stats.views += n;
+    return VF_OK;
+}
+
+vf_status vf_view_loss_classify(vf_view_loss *vl, const double *views, int n,
+                                vf_view_prediction *out, double *losses)
+{
+    for (int first = 0; first < n; first += VF_VIEW_LOSS_CHUNK) {
+        int m = n - first < VF_VIEW_LOSS_CHUNK ? n - first : VF_VIEW_LOSS_CHUNK;
+        vf_viewpoint vp[VF_VIEW_LOSS_CHUNK];
+        for (int i = 0; i < m; i++)
+            vp[i] = vf_viewpoint_from_array(views + 6 * (size_t)(first + i));
+        double t0 = vf_now();
+        vf_status status = vf_field_render_viewpoints(vl->field, &vl->camera, vp, m, vl->images);
+        vl->stats.render_seconds += vf_now() - t0;
+        if (status == VF_OK)
+            status = classify_rendered(vl, m, out + first);
+        if (status != VF_OK)
+            return status;
+        for (int i = 0; losses && i < m; i++)
+            losses[first + i] = vf_view_loss_of(out[first + i].label_prob);
+    }
+    return VF_OK;
+}
+
+vf_status vf_view_loss_classify_poses(vf_view_loss *vl, const double *c2w, int n,
+                                      vf_view_prediction *out)
+{
+    for (int first = 0; first < n; first += VF_VIEW_LOSS_CHUNK) {
+        int m = n - first < VF_VIEW_LOSS_CHUNK ? n - first : VF_VIEW_LOSS_CHUNK;
+        double t0 = vf_now();
+        vf_status status =
+            vf_field_render_batch(vl->field, &vl->camera, c2w + 16 * (size_t)first, m, vl->images);
+        vl->stats.render_seconds += vf_now() - t0;
+        if (status == VF_OK)
+            status = classify_rendered(vl, m, out + first);
+        if (status != VF_OK)
+            return status;
+    }
+    return VF_OK;
+}
+
+vf_status vf_view_loss_fn(const double *views, int n, double *losses, int *fooled, void *ctx)
+{
+    vf_view_loss *vl = ctx;
+    if (vl->label_count < 1)
+        return vf_fail(VF_EINTERNAL, "the attack loss has no label set");
+    vf_view_prediction *pred = malloc((size_t)n * sizeof *pred);
+    if (!pred)
+        return vf_fail(VF_EINTERNAL, "out of memory for %d predictions", n);
+    vf_status status = vf_view_loss_classify(vl, views, n, pred, losses);
+    for (int i = 0; status == VF_OK && fooled && i < n; i++)
+        fooled[i] = !pred[i].correct;
+    free(pred);
+    return status;
+}
+
+vf_status vf_view_loss_render(const vf_view_loss *vl, const double view[6], vf_image *out)
+{
+    vf_viewpoint vp = vf_viewpoint_from_array(view);
+    return vf_field_render_viewpoints(vl->field, &vl->camera, &vp, 1, out);
+}
+
+int vf_majority_class(const vf_view_prediction *pred, int n, int *votes)
+{
+    int count[VF_NUM_CLASSES] = {0}, best = 0;
+    for (int i = 0; i < n; i++)
+        count[pred[i].top_class]++;
+    for (int c = 1; c < VF_NUM_CLASSES; c++)
+        if (count[c] > count[best])
+            best = c;
+    if (votes)
+        *votes = count[best];
+    return best;
+}

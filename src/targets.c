@@ -1,0 +1,345 @@
+/* Adversarial viewpoints as places to stand, and guidance towards them (vf/targets.h). */
+#include "vf/targets.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vf/workspace.h"
+
+#define DEG (180.0 / M_PI)
+
+/* ---- attack.json ---- */
+
+static int read_six(const json_t *arr, double out[6])
+{
+    if (json_array_size(arr) != 6)
+        return 0;
+    for (int i = 0; i < 6; i++) {
+        if (!json_is_number(json_array_get(arr, i)))
+            return 0;
+        out[i] = json_number_value(json_array_get(arr, i));
+    }
+    return 1;
+}
+
+static double number_or_nan(const json_t *doc, const char *key)
+{
+    const json_t *x = json_object_get(doc, key);
+    return json_is_number(x) ? json_number_value(x) : NAN;
+}
+
+static void read_prediction(const json_t *p, vf_sample_prediction *out)
+{
+    const json_t *cls = json_object_get(p, "class");
+    out->cls = json_is_integer(cls) ? (int)json_integer_value(cls) : -1;
+    const char *name = json_string_value(json_object_get(p, "name"));
+    snprintf(out->name, sizeof out->name, "%s", name ? name : "?");
+    out->confidence = number_or_nan(p, "confidence");
+    out->fooled = json_is_true(json_object_get(p, "fooled"));
+}
+
+static vf_status read_labels(const json_t *doc, const char *path, vf_attack_file *a)
+{
+    const json_t *label = json_object_get(doc, "label");
+    const json_t *indices = json_object_get(label, "indices"), *names = json_object_get(label, "names");
+    size_t n = json_array_size(indices);
+    if (n == 0 || n > VF_MAX_LABELS)
+        return vf_fail(VF_EINPUT, "%s: \"label\" needs \"indices\" (1 to %d class numbers)", path,
+                       VF_MAX_LABELS);
+    size_t used = 0;
+    for (size_t i = 0; i < n; i++) {
+        a->labels[i] = (int)json_integer_value(json_array_get(indices, i));
+        const char *name = json_string_value(json_array_get(names, i));
+        if (name && used < sizeof a->label_text)
+            used += (size_t)snprintf(a->label_text + used, sizeof a->label_text - used, "%s%s",
+                                     used ? ", " : "", name);
+    }
+    a->label_count = (int)n;
+    return VF_OK;
+}
+
+static void read_camera(const json_t *doc, vf_attack_file *a)
+{
+    const json_t *c = json_object_get(doc, "camera");
+    double fx = number_or_nan(c, "fl_x"), fy = number_or_nan(c, "fl_y");
+    double cx = number_or_nan(c, "cx"), cy = number_or_nan(c, "cy");
+    double w = number_or_nan(c, "w"), h = number_or_nan(c, "h");
+    if (fx > 0 && fy > 0 && cx > 0 && cy > 0 && w >= 1 && h >= 1) {
+        a->has_camera = 1;
+        a->camera = (vf_camera){.width = (int)w, .height = (int)h, .fx = fx, .fy = fy, .cx = cx,
+                                .cy = cy};
+    }
+}
+
+static vf_status read_samples(const json_t *doc, const char *path, vf_attack_file *a)
+{
+    const json_t *samples = json_object_get(doc, "samples");
+    const json_t *preds = json_object_get(doc, "sample_predictions");
+    size_t n = json_array_size(samples);
+    a->samples = malloc(sizeof(double) * 6 * (n + 1));
+    if (!a->samples)
+        return vf_fail(VF_EINTERNAL, "out of memory reading %s", path);
+    for (size_t i = 0; i < n; i++)
+        if (!read_six(json_array_get(samples, i), a->samples + 6 * i))
+            return vf_fail(VF_EINPUT, "%s: samples[%zu] is not 6 numbers", path, i);
+    a->sample_count = (int)n;
+    if (n > 0 && json_array_size(preds) == n) {
+        a->predictions = calloc(n, sizeof *a->predictions);
+        if (!a->predictions)
+            return vf_fail(VF_EINTERNAL, "out of memory reading %s", path);
+        for (size_t i = 0; i < n; i++)
+            read_prediction(json_array_get(preds, i), &a->predictions[i]);
+    }
+    return VF_OK;
+}
+
+vf_status vf_attack_file_load(const char *path, vf_attack_file *out)
+{
+    memset(out, 0, sizeof *out);
+    json_t *doc;
+    vf_status status = vf_json_load(path, &doc);
+    if (status != VF_OK)
+        return status;
+    double v[6];
+    const json_t *bounds = json_object_get(doc, "bounds");
+    if (!read_six(json_object_get(doc, "v_star"), v))
+        status = vf_fail(VF_EINPUT, "%s: \"v_star\" must be 6 numbers (psi, theta, phi, dx, dy, "
+                                    "dz)", path);
+    else if (!read_six(json_object_get(bounds, "lo"), out->lo) ||
+             !read_six(json_object_get(bounds, "hi"), out->hi))
+        status = vf_fail(VF_EINPUT, "%s: \"bounds\" needs \"lo\" and \"hi\", 6 numbers each",
+                         path);
+    for (int i = 0; status == VF_OK && i < 6; i++)
+        if (!(out->hi[i] > out->lo[i]))
+            status = vf_fail(VF_EINPUT, "%s: bounds hi[%d] must exceed lo[%d]", path, i, i);
+    if (status == VF_OK)
+        status = read_labels(doc, path, out);
+    if (status == VF_OK)
+        status = read_samples(doc, path, out);
+    if (status == VF_OK) {
+        out->v_star = vf_viewpoint_from_array(v);
+        const char *model = json_string_value(json_object_get(doc, "model"));
+        snprintf(out->model, sizeof out->model, "%s", model ? model : "");
+        out->v_star_prediction.cls = -1;
+        if (json_is_object(json_object_get(doc, "v_star_prediction")))
+            read_prediction(json_object_get(doc, "v_star_prediction"), &out->v_star_prediction);
+        out->natural_accuracy = number_or_nan(doc, "natural_accuracy");
+        out->asr_v_star = number_or_nan(doc, "asr_v_star");
+        out->asr_samples = number_or_nan(doc, "asr_samples");
+        read_camera(doc, out);
+    }
+    json_decref(doc);
+    if (status != VF_OK)
+        vf_attack_file_free(out);
+    return status;
+}
+
+void vf_attack_file_free(vf_attack_file *a)
+{
+    free(a->samples);
+    free(a->predictions);
+    a->samples = NULL;
+    a->predictions = NULL;
+    a->sample_count = 0;
+}
+
+int vf_attack_is_label(const vf_attack_file *a, int cls)
+{
+    for (int i = 0; i < a->label_count; i++)
+        if (a->labels[i] == cls)
+            return 1;
+    return 0;
+}
+
+/* ---- words ---- */
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double a[3], const double b[3], double out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Camera position, forward (-z column) and up (y column) of a c2w. */
+static void camera_axes(const double c2w[16], double p[3], double f[3], double u[3])
+{
+    for (int k = 0; k < 3; k++) {
+        p[k] = c2w[4 * k + 3];
+        f[k] = -c2w[4 * k + 2];
+        u[k] = c2w[4 * k + 1];
+    }
+}
+
+static double azimuth_of(const double p[3])
+{
+    return atan2(p[0], -p[1]) * DEG;
+}
+
+/* Roll: the angle about the forward axis from world up (projected) to the camera's up. */
+static double roll_of(const double f[3], const double u[3])
+{
+    static const double z[3] = {0, 0, 1};
+    double w[3], c[3], fz = dot3(z, f);
+    for (int k = 0; k < 3; k++)
+        w[k] = z[k] - fz * f[k];
+    if (dot3(w, w) < 1e-12) /* looking straight up or down: no upright, no roll */
+        return 0;
+    cross3(w, u, c);
+    return atan2(dot3(f, c), dot3(w, u)) * DEG;
+}
+
+void vf_target_describe(const double c2w[16], vf_target_words *out)
+{
+    double p[3], f[3], u[3];
+    camera_axes(c2w, p, f, u);
+    double d = sqrt(dot3(p, p));
+    out->distance = d;
+    out->height = p[2];
+    out->azimuth_deg = azimuth_of(p);
+    out->elevation_deg = d > 0 ? asin(p[2] / d) * DEG : 0;
+    out->roll_deg = roll_of(f, u);
+    double along = -dot3(p, f); /* the optical axis passes nearest the origin here */
+    for (int k = 0; k < 3; k++)
+        out->look_at[k] = p[k] + along * f[k];
+    out->aim_offset = sqrt(dot3(out->look_at, out->look_at));
+}
+
+/* ---- spreading samples ---- */
+
+static double view_distance(const double *a, const double *b, const double lo[6],
+                            const double hi[6])
+{
+    double s = 0;
+    for (int i = 0; i < 6; i++) {
+        double d = a[i] - b[i];
+        if (i == 0)
+            d = remainder(d, 360.0);
+        d /= hi[i] - lo[i];
+        s += d * d;
+    }
+    return sqrt(s);
+}
+
+void vf_targets_spread(const double *views, int n, const double lo[6], const double hi[6], int m,
+                       int *picked)
+{
+    if (m > n)
+        m = n;
+    if (m <= 0)
+        return;
+    double *nearest = malloc(sizeof(double) * (size_t)n);
+    int medoid = 0;
+    double best = INFINITY;
+    for (int i = 0; i < n; i++) {
+        double sum = 0;
+        for (int j = 0; j < n; j++)
+            sum += view_distance(views + 6 * i, views + 6 * j, lo, hi);
+        if (sum < best) {
+            best = sum;
+            medoid = i;
+        }
+    }
+    picked[0] = medoid;
+    for (int i = 0; nearest && i < n; i++)
+        nearest[i] = view_distance(views + 6 * i, views + 6 * medoid, lo, hi);
+    for (int k = 1; k < m; k++) {
+        int far = 0;
+        for (int i = 1; nearest && i < n; i++)
+            if (nearest[i] > nearest[far])
+                far = i;
+        picked[k] = far;
+        for (int i = 0; nearest && i < n; i++) {
+            double d = view_distance(views + 6 * i, views + 6 * far, lo, hi);
+            nearest[i] = d < nearest[i] ? d : nearest[i];
+        }
+    }
+    free(nearest);
+}
+
+/* ---- guidance ---- */
+
+void vf_advice_compute(const double current[16], const double target[16], vf_advice *out)
+{
+    vf_target_words now, goal;
+    vf_target_describe(current, &now);
+    vf_target_describe(target, &goal);
+    out->orbit_deg = remainder(goal.azimuth_deg - now.azimuth_deg, 360.0);
+    out->raise = goal.height - now.height;
+    out->back = goal.distance - now.distance;
+    out->roll_deg = remainder(goal.roll_deg - now.roll_deg, 360.0);
+    /* Where the target camera looks, seen from the current camera once it has orbited
+     * (orbiting keeps facing the object): pan and tilt. */
+    double Rz[9], moved[16], orbit[16], zero[3] = {0, 0, 0};
+    vf_rot_z(out->orbit_deg / DEG, Rz);
+    vf_mat4_from_rt(Rz, zero, orbit);
+    vf_mat4_mul(orbit, current, moved);
+    double p[3], f[3], u[3], pt[3], ft[3], ut[3], r[3];
+    camera_axes(moved, p, f, u);
+    camera_axes(target, pt, ft, ut);
+    cross3(f, u, r); /* camera right */
+    out->pan_deg = atan2(dot3(ft, r), dot3(ft, f)) * DEG;
+    out->tilt_deg = atan2(dot3(ft, u), dot3(ft, f)) * DEG;
+}
+
+static size_t add_step(char *out, size_t size, size_t used, const char *text)
+{
+    if (used >= size)
+        return used;
+    int n = snprintf(out + used, size - used, "%s%s", used ? ", " : "", text);
+    return n > 0 ? used + (size_t)n : used;
+}
+
+static void distance_text(double units, double metres_per_unit, char *out, size_t size)
+{
+    if (metres_per_unit > 0)
+        snprintf(out, size, "%.0f cm", fabs(units) * metres_per_unit * 100);
+    else
+        snprintf(out, size, "%.2f units", fabs(units));
+}
+
+void vf_advice_text(const vf_advice *a, double metres_per_unit, double min_deg,
+                    double min_distance, char *out, size_t size)
+{
+    char step[96], d[48];
+    size_t used = 0;
+    out[0] = 0;
+    if (fabs(a->orbit_deg) >= min_deg) {
+        snprintf(step, sizeof step, "orbit %.0f deg %s", fabs(a->orbit_deg),
+                 a->orbit_deg > 0 ? "right" : "left");
+        used = add_step(out, size, used, step);
+    }
+    if (fabs(a->raise) >= min_distance) {
+        distance_text(a->raise, metres_per_unit, d, sizeof d);
+        snprintf(step, sizeof step, "%s %s", a->raise > 0 ? "raise" : "lower", d);
+        used = add_step(out, size, used, step);
+    }
+    if (fabs(a->back) >= min_distance) {
+        distance_text(a->back, metres_per_unit, d, sizeof d);
+        snprintf(step, sizeof step, "%s %s", a->back > 0 ? "step back" : "step closer", d);
+        used = add_step(out, size, used, step);
+    }
+    if (fabs(a->pan_deg) >= min_deg) {
+        snprintf(step, sizeof step, "turn %.0f deg %s", fabs(a->pan_deg),
+                 a->pan_deg > 0 ? "right" : "left");
+        used = add_step(out, size, used, step);
+    }
+    if (fabs(a->tilt_deg) >= min_deg) {
+        snprintf(step, sizeof step, "tilt %.0f deg %s", fabs(a->tilt_deg),
+                 a->tilt_deg > 0 ? "up" : "down");
+        used = add_step(out, size, used, step);
+    }
+    if (fabs(a->roll_deg) >= min_deg) {
+        snprintf(step, sizeof step, "roll %.0f deg %s", fabs(a->roll_deg),
+                 a->roll_deg > 0 ? "clockwise" : "counterclockwise");
+        used = add_step(out, size, used, step);
+    }
+    if (used == 0)
+        snprintf(out, size, "hold still: on target");
+}

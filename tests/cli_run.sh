@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# The pipeline end to end on a small budget: `run` on the chair (import, train, attack,
+# export), a second `run` that finds every stage up to date, `render` and `eval` of the
+# trained field, a benchmark set built and scored by two models, and bad input to those
+# commands failing with one line while the workspace stays as it was.
+source "$(dirname "$0")/cli_lib.sh"
+
+chair="$shared/data/nerf_synthetic/chair"
+ws="$tmp/chair"
+budget=(--minutes 0.5 --steps 2 --samples 6 --label "folding chair,rocking chair")
+
+expect 0 "run on the chair" -- "$tool" run "$chair/transforms_train.json" -o "$ws" "${budget[@]}" --json
+json_check "run reports the attack" 'd["attack"]["asr_v_star"] >= 0 and d["shot_card"].endswith("shot_card.png")'
+for f in train/model.vff train/report.json attack/attack.json attack/v_star.png export/targets.json export/shot_card.png; do
+  [ -s "$ws/$f" ] && ok || bad "run wrote $f"
+done
+python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["held_out_psnr"] > 18, r["held_out_psnr"]' "$ws/train/report.json" \
+  && ok || bad "held-out PSNR after 30 s of training is above 18 dB (a white image scores 14.4 dB): $(cat "$ws/train/report.json" | head -c 300)"
+
+expect 0 "run again" -- "$tool" run "$chair/transforms_train.json" -o "$ws" "${budget[@]}"
+[ "$(grep -c "is up to date" "$tmp/err")" -eq 4 ] && ok || bad "every stage up to date on the second run: $(cat "$tmp/err")"
+
+expect 0 "render a viewpoint" -- "$tool" render "$ws" --viewpoint 30,0,60,0,0,0 --size 128 -o "$tmp/view.png"
+[ -s "$tmp/view.png" ] && ok || bad "render wrote the image"
+expect 0 "render a pose" -- "$tool" render "$ws" --pose 1,0,0,0,0,1,0,0,0,0,1,4,0,0,0,1 -o "$tmp/pose.png" --quiet
+expect 0 "eval on the test views" -- "$tool" eval "$ws" --transforms "$chair/transforms_test.json" --out "$tmp/eval" --json
+json_check "eval: 10 views, mean PSNR above 17 dB (white: 14.4)" 'd["views"] == 10 and d["psnr"] > 17 and len(d["per_view"]) == 10'
+[ -s "$tmp/eval/render_009.png" ] && [ -s "$tmp/eval/error_009.png" ] && ok || bad "eval --out saved renders and error images"
+
+expect 0 "benchmark build" -- "$tool" benchmark build "$ws" -o "$tmp/set" --count 4 --quiet
+[ "$(ls "$tmp/set/images" | wc -l)" -eq 8 ] && ok || bad "4 natural + 4 adversarial images"
+expect 0 "benchmark eval" -- "$tool" benchmark eval "$tmp/set" --models mobilenet_v2_1.0_224_quant,mobilenet_v1_0.5_160_quant --json --quiet
+json_check "two models, natural and adversarial rows of 4 images" \
+  'len(d["results"]) == 8 and all(r["total"] == 4 for r in d["results"])'
+[ -s "$tmp/set/accuracy.png" ] && [ -s "$tmp/set/results.md" ] && ok || bad "benchmark reports written"
+
+# Bad input: one line, exit 1, the workspace as it was.
+cp "$ws/manifest.json" "$tmp/manifest.before"
+expect 1 "train: no workspace" -- "$tool" train "$tmp/nowhere"
+one_line_naming "train: no workspace" "nowhere"
+expect 1 "train: bad --minutes" -- "$tool" train "$ws" --minutes -1
+one_line_naming "train: bad --minutes" "--minutes"
+expect 1 "render: malformed viewpoint" -- "$tool" render "$ws" --viewpoint 1,2,3 -o "$tmp/x.png"
+one_line_naming "render: malformed viewpoint" "--viewpoint"
+expect 1 "eval: missing test set" -- "$tool" eval "$ws" --transforms "$tmp/none.json"
+one_line_naming "eval: missing test set" "none.json"
+expect 1 "benchmark eval: not a set" -- "$tool" benchmark eval "$ws"
+one_line_naming "benchmark eval: not a set" "index.json"
+expect 1 "benchmark build: existing folder" -- "$tool" benchmark build "$ws" -o "$tmp/set"
+one_line_naming "benchmark build: existing folder" "already exists"
+expect 1 "run: missing input" -- "$tool" run "$tmp/missing.mp4" -o "$ws"
+one_line_naming "run: missing input" "missing.mp4"
+cp "$ws/train/model.vff" "$tmp/model.keep"
+head -c 5000 "$tmp/model.keep" >"$ws/train/model.vff"
+expect 1 "render: truncated model" -- "$tool" render "$ws" --viewpoint 0,0,60,0,0,0 -o "$tmp/x.png"
+one_line_naming "render: truncated model" "model.vff"
+cp "$tmp/model.keep" "$ws/train/model.vff"
+cmp -s "$ws/manifest.json" "$tmp/manifest.before" && ok || bad "failed commands left the manifest as it was"
+
+cli_finish

@@ -1,0 +1,306 @@
+/* Unit tests of the radiance-field engine on small synthetic fields: the inlined math, the
+ * gradients of the ray marcher against finite differences, the fast renderer against the
+ * training forward pass, deterministic rendering, model files (round trip, corrupt and
+ * other-version files rejected) and checkpoint resume. */
+#include "check.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/field/fast_math.h"
+#include "../src/field/trainer_internal.h"
+#include "vf/error.h"
+#include "vf/field.h"
+#include "vf/pose.h"
+
+static uint64_t rng_state = 0x2545f4914f6cdd1dull;
+static float uniform(float lo, float hi)
+{
+    rng_state ^= rng_state << 13, rng_state ^= rng_state >> 7, rng_state ^= rng_state << 17;
+    return lo + (hi - lo) * (float)((rng_state >> 40) / 16777216.0);
+}
+
+/* A 12^3 field over [-1, 1]^3 with smooth random density and colour. */
+static vf_field *make_field(void)
+{
+    vf_field *f = calloc(1, sizeof *f);
+    const int dim[3] = {12, 12, 12};
+    const float lo[3] = {-1, -1, -1};
+    float voxel = 2.0f / 11;
+    if (field_grid_alloc(&f->grids[0], dim, lo, voxel) != VF_OK)
+        abort();
+    f->grid_count = 1;
+    field_grid *g = &f->grids[0];
+    for (size_t i = 0; i < g->points; i++) {
+        float *v = g->values + i * FIELD_CH;
+        int x = (int)(i % 12), y = (int)(i / 12 % 12), z = (int)(i / 144);
+        float r2 = ((x - 5.5f) * (x - 5.5f) + (y - 5.5f) * (y - 5.5f) + (z - 5.5f) * (z - 5.5f));
+        v[FIELD_CH_DENSITY] = 2.0f - 0.15f * r2 + uniform(-0.5f, 0.5f);
+        for (int ch = FIELD_CH_SH; ch < FIELD_CH_USED; ch++)
+            v[ch] = uniform(-1, 1);
+    }
+    f->density_scale = 1.0f / voxel;
+    f->density_shift = -2.0f;
+    f->step_ratio = 0.5f;
+    f->background[0] = f->background[1] = f->background[2] = 1.0f;
+    f->occupancy_alpha = 1e-4f;
+    f->stop_transmittance = 1e-3f;
+    f->camera = (vf_camera){.width = 32, .height = 32, .fx = 40, .fy = 40, .cx = 16, .cy = 16};
+    f->camera_distance = 4;
+    field_grid_update_occupancy(g, f, f->step_ratio * voxel);
+    return f;
+}
+
+static void test_fast_math(void)
+{
+    double worst_exp = 0, worst_sp = 0, worst_sig = 0;
+    /* float x * log2(e) rounds: the error grows with |x| (2e-6 at 20, where alpha saturates) */
+    for (float x = -20; x < 20; x += 0.0137f) {
+        double e = exp((double)x);
+        worst_exp = fmax(worst_exp, fabs(fast_exp(x) - e) / e);
+        double sp = log1p(exp((double)x));
+        worst_sp = fmax(worst_sp, fabs(fast_softplus(x) - sp) / sp);
+        worst_sig = fmax(worst_sig, fabs(fast_sigmoid(x) - 1 / (1 + exp(-(double)x))));
+    }
+    CHECK(worst_exp < 2e-6, "fast_exp relative error %g", worst_exp);
+    CHECK(worst_sp < 2e-6, "fast_softplus relative error %g", worst_sp);
+    CHECK(worst_sig < 1e-6, "fast_sigmoid error %g", worst_sig);
+}
+
+/* loss = g . rgb(ray) for a fixed g; its gradient by field_backward and by central differences. */
+static double ray_loss(const vf_field *f, const field_ray *ray, field_scratch *sc, const float g[3])
+{
+    field_march_result res;
+    field_march(f, ray, 0.3f, 0.0f, sc, &res);
+    return (double)g[0] * res.rgb[0] + (double)g[1] * res.rgb[1] + (double)g[2] * res.rgb[2];
+}
+
+static void test_gradients(void)
+{
+    vf_field *f = make_field();
+    field_grid *grid = &f->grids[0];
+    field_grid_fill_occupancy(grid); /* no skipping: the loss is smooth in every value */
+    field_scratch sc = {.capacity = field_max_samples(f)};
+    sc.samples = malloc((size_t)sc.capacity * sizeof *sc.samples);
+    field_grad_sink sink = {0};
+    sink.grad[0] = calloc(grid->points * FIELD_CH, sizeof(float));
+    sink.touched[0] = calloc(grid->points, 1);
+    sink.list[0] = malloc(grid->points * sizeof(uint32_t));
+
+    field_ray ray = {.origin = {0.13f, -0.21f, 4.0f}, .dir = {0.03f, 0.05f, -1.0f}, .tmax = 1e30f};
+    float n = sqrtf(ray.dir[0] * ray.dir[0] + ray.dir[1] * ray.dir[1] + ray.dir[2] * ray.dir[2]);
+    for (int a = 0; a < 3; a++)
+        ray.dir[a] /= n;
+    const float g[3] = {0.7f, -0.4f, 0.9f};
+    field_march_result res;
+    field_march(f, &ray, 0.3f, 0.0f, &sc, &res);
+    CHECK(res.count > 10, "the test ray takes %d samples", res.count);
+    CHECK(res.trans > 0.01f && res.trans < 0.99f, "the test ray is partly opaque (T = %g)",
+          res.trans);
+    field_backward(f, &ray, &sc, &res, g, &sink);
+    CHECK(sink.count[0] > 8, "the ray touched %zu points", sink.count[0]);
+
+    int checked = 0, bad = 0;
+    double worst = 0;
+    for (size_t k = 0; k < sink.count[0]; k += 3) {
+        size_t i = sink.list[0][k];
+        for (int ch = 0; ch < FIELD_CH_USED; ch += 4) {
+            float *value = &grid->values[i * FIELD_CH + ch];
+            const float saved = *value, h = 1e-2f;
+            *value = saved + h;
+            double up = ray_loss(f, &ray, &sc, g);
+            *value = saved - h;
+            double down = ray_loss(f, &ray, &sc, g);
+            *value = saved;
+            double numeric = (up - down) / (2 * h), analytic = sink.grad[0][i * FIELD_CH + ch];
+            double err = fabs(numeric - analytic) / fmax(1e-3, fabs(numeric) + fabs(analytic));
+            worst = fmax(worst, err);
+            bad += err > 0.02;
+            checked++;
+        }
+    }
+    CHECK(checked > 20, "checked %d gradients", checked);
+    CHECK(bad == 0, "%d of %d gradients differ from finite differences (worst relative %g)", bad,
+          checked, worst);
+    free(sink.grad[0]);
+    free(sink.touched[0]);
+    free(sink.list[0]);
+    free(sc.samples);
+    vf_field_free(f);
+}
+
+static double max_diff(const vf_image *a, const vf_image *b)
+{
+    double worst = 0;
+    for (size_t i = 0; i < (size_t)a->width * a->height * a->channels; i++)
+        worst = fmax(worst, fabs(a->data[i] - b->data[i]));
+    return worst;
+}
+
+/* The fast renderer against the training forward pass, pixel by pixel. */
+static void test_render_matches_march(void)
+{
+    vf_field *f = make_field();
+    vf_viewpoint v = {.psi = 30, .theta = 10, .phi = 60};
+    double c2w[16];
+    vf_viewpoint_to_c2w(&v, c2w);
+    vf_image img = {0}, again = {0};
+    CHECK(vf_field_render(f, &f->camera, c2w, &img) == VF_OK, "render: %s", vf_error_message());
+    double worst = 0, coloured = 0;
+    for (int y = 0; y < img.height; y++)
+        for (int x = 0; x < img.width; x++) {
+            field_ray ray;
+            field_march_result res;
+            field_camera_ray(&f->camera, c2w, x + 0.5, y + 0.5, &ray);
+            field_march(f, &ray, 0.5f, f->stop_transmittance, NULL, &res);
+            for (int k = 0; k < 3; k++) {
+                worst = fmax(worst, fabs(res.rgb[k] - img.data[3 * (y * img.width + x) + k]));
+                coloured = fmax(coloured, fabs(res.rgb[k] - 1.0f));
+            }
+        }
+    CHECK(coloured > 0.2, "the field is visible (largest difference from white %g)", coloured);
+    CHECK(worst < 5e-3, "fast render differs from the training forward pass by %g", worst);
+    /* deterministic, also through the batch path and in place */
+    CHECK(vf_field_render(f, &f->camera, c2w, &again) == VF_OK, "render again");
+    CHECK(max_diff(&img, &again) == 0, "two renders differ by %g", max_diff(&img, &again));
+    vf_image batch[3] = {{0}};
+    vf_viewpoint vs[3] = {v, v, v};
+    CHECK(vf_field_render_viewpoints(f, &f->camera, vs, 3, batch) == VF_OK, "batch render");
+    for (int i = 0; i < 3; i++)
+        CHECK(max_diff(&img, &batch[i]) == 0, "batch render %d differs", i);
+    for (int i = 0; i < 3; i++)
+        vf_image_free(&batch[i]);
+    vf_image_free(&img);
+    vf_image_free(&again);
+    vf_field_free(f);
+}
+
+static int patch_file(const char *path, long offset, const void *bytes, size_t n)
+{
+    FILE *fp = fopen(path, "r+b");
+    if (!fp)
+        return -1;
+    fseek(fp, offset, SEEK_SET);
+    int ok = fwrite(bytes, 1, n, fp) == n;
+    fclose(fp);
+    return ok ? 0 : -1;
+}
+
+static void test_model_files(void)
+{
+    vf_field *f = make_field();
+    char path[512], copy[600];
+    snprintf(path, sizeof path, "%s/model.vff", vf_test_tmpdir());
+    snprintf(copy, sizeof copy, "%s.bad", path);
+    CHECK(vf_field_save(f, path) == VF_OK, "save: %s", vf_error_message());
+    vf_field *loaded = NULL;
+    CHECK(vf_field_load(path, &loaded) == VF_OK, "load: %s", vf_error_message());
+    if (loaded) {
+        vf_viewpoint v = {.psi = -40, .theta = 5, .phi = 120, .dy = -0.5};
+        vf_image a = {0}, b = {0};
+        vf_field_render_viewpoints(f, &f->camera, &v, 1, &a);
+        vf_field_render_viewpoints(loaded, &loaded->camera, &v, 1, &b);
+        CHECK(a.data && b.data && max_diff(&a, &b) == 0, "saved and loaded fields render alike");
+        vf_image_free(&a);
+        vf_image_free(&b);
+        vf_field_free(loaded);
+    }
+    /* a flipped byte in the grid values */
+    vf_test_system("cp '%s' '%s'", path, copy);
+    const unsigned char junk = 0x5a;
+    patch_file(copy, 2000, &junk, 1);
+    loaded = NULL;
+    CHECK(vf_field_load(copy, &loaded) == VF_EINPUT && !loaded, "corrupt file rejected");
+    CHECK(strstr(vf_error_message(), "corrupt") != NULL, "message: %s", vf_error_message());
+    /* another format version */
+    vf_test_system("cp '%s' '%s'", path, copy);
+    const uint32_t version = 99;
+    patch_file(copy, 8, &version, sizeof version);
+    CHECK(vf_field_load(copy, &loaded) == VF_EINPUT && !loaded, "other version rejected");
+    CHECK(strstr(vf_error_message(), "version 99") != NULL, "message: %s", vf_error_message());
+    /* truncated, and not a model at all */
+    vf_test_system("head -c 3000 '%s' > '%s'", path, copy);
+    CHECK(vf_field_load(copy, &loaded) == VF_EINPUT && !loaded, "truncated file rejected");
+    vf_test_system("echo hello > '%s'", copy);
+    CHECK(vf_field_load(copy, &loaded) == VF_EINPUT && !loaded, "non-model rejected");
+    CHECK(vf_field_load("/nonexistent/model.vff", &loaded) == VF_EINPUT, "missing file");
+    vf_field_free(f);
+}
+
+/* Training views: renders of the synthetic field from a ring of cameras. */
+static void add_views(vf_field_trainer *t, const vf_field *f, int count)
+{
+    for (int i = 0; i < count; i++) {
+        vf_viewpoint v = {.psi = -180 + 360.0 * i / count, .theta = 0, .phi = 40 + 15 * (i % 5)};
+        double c2w[16];
+        vf_viewpoint_to_c2w(&v, c2w);
+        vf_image img = {0};
+        vf_field_render(f, &f->camera, c2w, &img);
+        CHECK(vf_field_trainer_add_view(t, &f->camera, c2w, &img) == VF_OK, "add view: %s",
+              vf_error_message());
+        vf_image_free(&img);
+    }
+}
+
+static void test_checkpoint_resume(void)
+{
+    vf_field *truth = make_field();
+    vf_field_train_options opt;
+    vf_field_train_defaults(&opt);
+    opt.seconds = 0;
+    opt.steps = 40;
+    opt.batch_rays = 256;
+    opt.max_points = 16 * 16 * 16;
+    opt.levels = 2;
+    opt.threads = 2;
+    char ckpt[512];
+    snprintf(ckpt, sizeof ckpt, "%s/train.ckpt", vf_test_tmpdir());
+
+    vf_field_trainer *t = NULL;
+    CHECK(vf_field_trainer_create(&opt, &t) == VF_OK, "create");
+    add_views(t, truth, 12);
+    CHECK(vf_field_trainer_start(t) == VF_OK, "start: %s", vf_error_message());
+    vf_field_train_status st;
+    for (int i = 0; i < 15; i++)
+        vf_field_trainer_step(t, &st);
+    CHECK(st.step == 15, "15 steps taken (%d)", st.step);
+    CHECK(vf_field_trainer_save_checkpoint(t, ckpt) == VF_OK, "checkpoint: %s",
+          vf_error_message());
+
+    vf_field_trainer *r = NULL;
+    vf_field_trainer_create(&opt, &r);
+    add_views(r, truth, 12);
+    CHECK(vf_field_trainer_resume(r, ckpt) == VF_OK, "resume: %s", vf_error_message());
+    /* the resumed trainer holds exactly the checkpointed field */
+    const field_grid *a = &vf_field_trainer_field(t)->grids[0];
+    const field_grid *b = &vf_field_trainer_field(r)->grids[0];
+    CHECK(a->points == b->points &&
+              !memcmp(a->values, b->values, a->points * FIELD_CH * sizeof(float)),
+          "a resumed run starts from the checkpointed field");
+    vf_field_train_status rs;
+    CHECK(vf_field_trainer_step(r, &rs) == VF_OK && rs.step == 16, "resumed at step 16 (%d)",
+          rs.step);
+    while (!rs.done)
+        vf_field_trainer_step(r, &rs);
+    CHECK(rs.step == 40, "resumed run ends at the step budget (%d)", rs.step);
+
+    /* other views: rejected */
+    vf_field_trainer *other = NULL;
+    vf_field_trainer_create(&opt, &other);
+    add_views(other, truth, 11);
+    CHECK(vf_field_trainer_resume(other, ckpt) == VF_EINPUT, "checkpoint of other views refused");
+    vf_field_trainer_free(other);
+    vf_field_trainer_free(r);
+    vf_field_trainer_free(t);
+    vf_field_free(truth);
+}
+
+int main(void)
+{
+    test_fast_math();
+    test_gradients();
+    test_render_matches_march();
+    test_model_files();
+    test_checkpoint_resume();
+    return check_finish();
+}
