@@ -1,10 +1,8 @@
 /* Finding the board in a folder of photos, a video or a webcam's stream (vf/calib.h). */
 #define _GNU_SOURCE
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #include "vf/calib.h"
 #include "vf/log.h"
@@ -12,51 +10,12 @@
 
 #define CAMERA_TIMEOUT_MS 5000 /* a camera that sends nothing for this long has stopped */
 
-static int is_image_name(const char *name)
-{
-    const char *dot = strrchr(name, '.');
-    return name[0] != '.' && dot &&
-           (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg") || !strcasecmp(dot, ".png"));
-}
-
-static int compare_names(const void *a, const void *b)
-{
-    return strcmp(*(char *const *)a, *(char *const *)b);
-}
-
-/* The image file names in a folder, sorted; the caller frees each and the array. */
+/* The image file names in a folder, sorted; the caller frees them with vf_free_names. */
 static vf_status list_images(const char *folder, char ***names, int *count)
 {
-    DIR *dir = opendir(folder);
-    if (!dir)
-        return vf_fail(VF_EINPUT, "cannot open folder %s", folder);
-    struct dirent *entry;
-    int capacity = 0;
-    vf_status status = VF_OK;
-    *names = NULL;
-    *count = 0;
-    while (status == VF_OK && (entry = readdir(dir))) {
-        if (!is_image_name(entry->d_name))
-            continue;
-        if (*count == capacity) {
-            capacity = capacity ? 2 * capacity : 64;
-            char **grown = realloc(*names, (size_t)capacity * sizeof *grown);
-            if (!grown) {
-                status = vf_fail(VF_EINTERNAL, "out of memory listing %s", folder);
-                break;
-            }
-            *names = grown;
-        }
-        if (!((*names)[*count] = strdup(entry->d_name)))
-            status = vf_fail(VF_EINTERNAL, "out of memory listing %s", folder);
-        else
-            (*count)++;
-    }
-    closedir(dir);
+    vf_status status = vf_list_images(folder, names, count);
     if (status == VF_OK && *count == 0)
         status = vf_fail(VF_EINPUT, "folder %s has no .jpg or .png images of the board", folder);
-    if (status == VF_OK)
-        qsort(*names, (size_t)*count, sizeof **names, compare_names);
     return status;
 }
 
@@ -115,9 +74,7 @@ vf_status vf_calib_collect_folder(const char *folder, const vf_calib_board *boar
             status = vf_calib_views_add(out, results[i].width, results[i].height, names[i],
                                         uv + (size_t)i * corners * 2, corners);
     }
-    for (int i = 0; i < count; i++)
-        free(names[i]);
-    free(names);
+    vf_free_names(names, count);
     free(uv);
     free(results);
     return status;

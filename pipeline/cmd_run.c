@@ -31,18 +31,19 @@ static const char usage[] =
     "                       majority vote over natural views)\n"
     "  -n, --frames N       frames to keep from a video or photo folder (default 100)\n"
     "      --minutes M      radiance-field training time (default 3)\n"
+    "      --train-steps N  train for N steps instead (the same field on a busy machine)\n"
     "      --samples K      attack samples per step (default 50)\n"
     "      --steps S        attack steps (default 100)\n"
     "      --restart        redo every stage, even those that are up to date\n" CLI_COMMON_HELP;
 
-enum { OPT_MINUTES = CLI_OPT_FIRST_CUSTOM, OPT_SAMPLES, OPT_STEPS, OPT_RESTART };
+enum { OPT_MINUTES = CLI_OPT_FIRST_CUSTOM, OPT_TRAIN_STEPS, OPT_SAMPLES, OPT_STEPS, OPT_RESTART };
 
 #define MAX_STAGE_ARGS 24
 
 typedef struct run_options {
     const char *input;
     const char *workspace;
-    const char *model, *label, *frames, *minutes, *samples, *steps;
+    const char *model, *label, *frames, *minutes, *train_steps, *samples, *steps;
     int restart;
     cli_flags flags;
 } run_options;
@@ -102,6 +103,7 @@ static int plan_stages(const run_options *opt, stage_call *calls)
     push(c, "train");
     push(c, opt->workspace);
     push_option(c, "--minutes", opt->minutes);
+    push_option(c, "--steps", opt->train_steps);
 
     c = &calls[n++];
     *c = (stage_call){.name = "attack", .run = cmd_attack};
@@ -157,6 +159,7 @@ static vf_status parse_options(int argc, char **argv, run_options *opt)
         {"label", required_argument, NULL, 'l'},
         {"frames", required_argument, NULL, 'n'},
         {"minutes", required_argument, NULL, OPT_MINUTES},
+        {"train-steps", required_argument, NULL, OPT_TRAIN_STEPS},
         {"samples", required_argument, NULL, OPT_SAMPLES},
         {"steps", required_argument, NULL, OPT_STEPS},
         {"restart", no_argument, NULL, OPT_RESTART},
@@ -172,6 +175,7 @@ static vf_status parse_options(int argc, char **argv, run_options *opt)
         case 'l': opt->label = optarg; break;
         case 'n': opt->frames = optarg; break;
         case OPT_MINUTES: opt->minutes = optarg; break;
+        case OPT_TRAIN_STEPS: opt->train_steps = optarg; break;
         case OPT_SAMPLES: opt->samples = optarg; break;
         case OPT_STEPS: opt->steps = optarg; break;
         case OPT_RESTART: opt->restart = 1; break;

@@ -20,7 +20,8 @@
 #define CHECKPOINT_FILE "checkpoint.vfc"
 
 static const char usage[] =
-    "usage: vfcapture train WS [--minutes M] [--holdout N] [--keep-background] [--restart]\n"
+    "usage: vfcapture train WS [--minutes M | --steps N] [--holdout N] [--keep-background]\n"
+    "                      [--restart]\n"
     "\n"
     "Fit a radiance field (an explicit density + spherical-harmonics grid, coarse to fine) to\n"
     "the posed images of WS: the undistorted frames of the poses stage, or an imported posed\n"
@@ -29,16 +30,19 @@ static const char usage[] =
     "\n"
     "options:\n"
     "      --minutes M        training wall time (default 3)\n"
+    "      --steps N          train for N optimizer steps instead of a time (the same field\n"
+    "                         however busy the machine is)\n"
     "      --holdout N        hold out every Nth view for scoring, 0 for none (default 10)\n"
     "      --keep-background  opaque photos: also model the surroundings beyond the object\n"
     "                         (default: only the region the cameras look at)\n"
     "      --restart          ignore a checkpoint of an interrupted run\n" CLI_COMMON_HELP;
 
-enum { OPT_MINUTES = CLI_OPT_FIRST_CUSTOM, OPT_HOLDOUT, OPT_KEEP_BACKGROUND, OPT_RESTART };
+enum { OPT_MINUTES = CLI_OPT_FIRST_CUSTOM, OPT_STEPS, OPT_HOLDOUT, OPT_KEEP_BACKGROUND, OPT_RESTART };
 
 typedef struct train_options {
     const char *workspace;
     double minutes;
+    int steps; /* > 0: a step budget instead of minutes */
     int holdout, keep_background, restart;
     cli_flags flags;
 } train_options;
@@ -48,6 +52,7 @@ static vf_status parse_options(int argc, char **argv, train_options *opt)
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
         {"minutes", required_argument, NULL, OPT_MINUTES},
+        {"steps", required_argument, NULL, OPT_STEPS},
         {"holdout", required_argument, NULL, OPT_HOLDOUT},
         {"keep-background", no_argument, NULL, OPT_KEEP_BACKGROUND},
         {"restart", no_argument, NULL, OPT_RESTART},
@@ -63,6 +68,11 @@ static vf_status parse_options(int argc, char **argv, train_options *opt)
                 opt->minutes > 600)
                 return vf_fail(VF_EINPUT, "--minutes must be a number above 0 (up to 600), not "
                                           "'%s'", optarg);
+        } else if (c == OPT_STEPS) {
+            if (cli_parse_int(optarg, 1, 10000000, &value) != 0)
+                return vf_fail(VF_EINPUT, "--steps must be a whole number from 1 up, not '%s'",
+                               optarg);
+            opt->steps = (int)value;
         } else if (c == OPT_HOLDOUT) {
             if (cli_parse_int(optarg, 0, 1000000, &value) != 0 || value == 1)
                 return vf_fail(VF_EINPUT, "--holdout must be 0 or a whole number from 2 up, not "
@@ -198,7 +208,9 @@ static vf_status train(const train_options *opt, vf_workspace *ws)
 
     vf_field_train_options topt;
     vf_field_train_defaults(&topt);
-    topt.seconds = 60 * opt->minutes;
+    topt.seconds = opt->steps ? 0 : 60 * opt->minutes;
+    if (opt->steps)
+        topt.steps = opt->steps;
     topt.keep_background = opt->keep_background;
     vf_field_trainer *t = NULL;
     vf_stage stage;
@@ -223,8 +235,12 @@ static vf_status train(const train_options *opt, vf_workspace *ws)
     }
     vf_field_train_status st;
     if (status == VF_OK) {
-        vf_info("training on %d views (%d held out) for %.1f minutes on all cores",
-                views.count - held, held, opt->minutes);
+        if (opt->steps)
+            vf_info("training on %d views (%d held out) for %d steps on all cores",
+                    views.count - held, held, opt->steps);
+        else
+            vf_info("training on %d views (%d held out) for %.1f minutes on all cores",
+                    views.count - held, held, opt->minutes);
         status = run_training(t, checkpoint, &st);
     }
 
@@ -265,8 +281,9 @@ static vf_status train(const train_options *opt, vf_workspace *ws)
                                        ssim, "steps", st.step)
                            : json_pack("{s:i}", "steps", st.step);
     status = vf_stage_commit(&stage,
-                             json_pack("{s:f, s:i, s:b}", "minutes", opt->minutes, "holdout",
-                                       opt->holdout, "keep_background", opt->keep_background),
+                             json_pack("{s:f, s:i, s:i, s:b}", "minutes", opt->minutes, "steps",
+                                       opt->steps, "holdout", opt->holdout, "keep_background",
+                                       opt->keep_background),
                              json_incref(summary));
     if (status == VF_OK)
         status = vf_workspace_path(ws, "train", "model.vff", model, sizeof model);

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -184,4 +185,61 @@ vf_status vf_copy_file(const char *src, const char *dst)
     status = vf_write_file_atomic(dst, data, size);
     free(data);
     return status;
+}
+
+static int is_image_name(const char *name)
+{
+    const char *dot = strrchr(name, '.');
+    return name[0] != '.' && dot &&
+           (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg") || !strcasecmp(dot, ".png"));
+}
+
+static int compare_names(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+vf_status vf_list_images(const char *folder, char ***names, int *count)
+{
+    *names = NULL;
+    *count = 0;
+    DIR *dir = opendir(folder);
+    if (!dir)
+        return vf_fail(VF_EINPUT, "cannot open folder %s: %s", folder, strerror(errno));
+    struct dirent *entry;
+    int capacity = 0;
+    vf_status status = VF_OK;
+    while (status == VF_OK && (entry = readdir(dir))) {
+        if (!is_image_name(entry->d_name))
+            continue;
+        if (*count == capacity) {
+            capacity = capacity ? 2 * capacity : 64;
+            char **grown = realloc(*names, (size_t)capacity * sizeof *grown);
+            if (!grown) {
+                status = vf_fail(VF_EINTERNAL, "out of memory listing %s", folder);
+                break;
+            }
+            *names = grown;
+        }
+        if (!((*names)[*count] = strdup(entry->d_name)))
+            status = vf_fail(VF_EINTERNAL, "out of memory listing %s", folder);
+        else
+            (*count)++;
+    }
+    closedir(dir);
+    if (status != VF_OK) {
+        vf_free_names(*names, *count);
+        *names = NULL;
+        *count = 0;
+    } else {
+        qsort(*names, (size_t)*count, sizeof **names, compare_names);
+    }
+    return status;
+}
+
+void vf_free_names(char **names, int count)
+{
+    for (int i = 0; i < count; i++)
+        free(names[i]);
+    free(names);
 }

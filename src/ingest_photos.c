@@ -1,10 +1,8 @@
 /* Ingest from a folder of photos: score them all (in parallel), choose, write the chosen ones. */
 #define _GNU_SOURCE
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #include "ingest_internal.h"
 #include "vf/log.h"
@@ -16,60 +14,18 @@ typedef struct photo_list {
 
 static void photo_list_free(photo_list *list)
 {
-    for (int i = 0; i < list->count; i++)
-        free(list->names[i]);
-    free(list->names);
+    vf_free_names(list->names, list->count);
     memset(list, 0, sizeof *list);
-}
-
-static int is_photo_name(const char *name)
-{
-    const char *dot = strrchr(name, '.');
-    return name[0] != '.' && dot &&
-           (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg") || !strcasecmp(dot, ".png"));
-}
-
-static int compare_names(const void *a, const void *b)
-{
-    return strcmp(*(char *const *)a, *(char *const *)b);
 }
 
 static vf_status list_photos(const char *folder, photo_list *list)
 {
-    memset(list, 0, sizeof *list);
-    DIR *dir = opendir(folder);
-    if (!dir)
-        return vf_fail(VF_EINPUT, "cannot open folder %s", folder);
-    struct dirent *entry;
-    int capacity = 0;
-    vf_status status = VF_OK;
-    while (status == VF_OK && (entry = readdir(dir))) {
-        if (!is_photo_name(entry->d_name))
-            continue;
-        if (list->count == capacity) {
-            capacity = capacity ? 2 * capacity : 64;
-            char **names = realloc(list->names, sizeof *names * (size_t)capacity);
-            if (!names) {
-                status = vf_fail(VF_EINTERNAL, "out of memory listing %s", folder);
-                break;
-            }
-            list->names = names;
-        }
-        if (!(list->names[list->count] = strdup(entry->d_name)))
-            status = vf_fail(VF_EINTERNAL, "out of memory listing %s", folder);
-        else
-            list->count++;
-    }
-    closedir(dir);
+    vf_status status = vf_list_images(folder, &list->names, &list->count);
     if (status == VF_OK && list->count == 0)
         status = vf_fail(VF_EINPUT,
                          "folder %s has no JPEG or PNG photos; give a folder of photos or a "
                          "video file",
                          folder);
-    if (status != VF_OK)
-        photo_list_free(list);
-    else
-        qsort(list->names, (size_t)list->count, sizeof *list->names, compare_names);
     return status;
 }
 

@@ -2,60 +2,30 @@
 #define _GNU_SOURCE
 #include "vf/sfm_images.h"
 
-#include <dirent.h>
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 #include <unistd.h>
 
 #include "vf/image.h"
 #include "vf/log.h"
 
-static int is_image_name(const char *name)
-{
-    const char *dot = strrchr(name, '.');
-    return name[0] != '.' && dot &&
-           (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg") || !strcasecmp(dot, ".png"));
-}
-
-static int compare_frames(const void *a, const void *b)
-{
-    return strcmp(((const vf_sfm_frame *)a)->source, ((const vf_sfm_frame *)b)->source);
-}
-
 /* Fill out->frames with the images of src_dir (source paths only), sorted. */
 static vf_status list_images(const char *src_dir, vf_sfm_images *out)
 {
-    DIR *dir = opendir(src_dir);
-    if (!dir)
-        return vf_fail(VF_EINPUT, "cannot open %s: %s", src_dir, strerror(errno));
-    int capacity = 0;
-    vf_status status = VF_OK;
-    struct dirent *entry;
-    while (status == VF_OK && (entry = readdir(dir))) {
-        if (!is_image_name(entry->d_name))
-            continue;
-        if (out->count == capacity) {
-            capacity = capacity ? 2 * capacity : 64;
-            vf_sfm_frame *frames = realloc(out->frames, (size_t)capacity * sizeof *frames);
-            if (!frames) {
-                status = vf_fail(VF_EINTERNAL, "out of memory listing %s", src_dir);
-                break;
-            }
-            out->frames = frames;
-        }
-        vf_sfm_frame *f = &out->frames[out->count];
-        memset(f, 0, sizeof *f);
-        status = vf_path_join(f->source, sizeof f->source, src_dir, entry->d_name);
+    char **names;
+    int count;
+    vf_status status = vf_list_images(src_dir, &names, &count);
+    if (status == VF_OK && count == 0)
+        status = vf_fail(VF_EINPUT, "%s holds no JPEG or PNG images", src_dir);
+    if (status == VF_OK && !(out->frames = calloc((size_t)count, sizeof *out->frames)))
+        status = vf_fail(VF_EINTERNAL, "out of memory listing %s", src_dir);
+    for (int i = 0; i < count && status == VF_OK; i++) {
+        status = vf_path_join(out->frames[i].source, sizeof out->frames[i].source, src_dir,
+                              names[i]);
         out->count += status == VF_OK;
     }
-    closedir(dir);
-    if (status == VF_OK && out->count == 0)
-        status = vf_fail(VF_EINPUT, "%s holds no JPEG or PNG images", src_dir);
-    if (status == VF_OK)
-        qsort(out->frames, (size_t)out->count, sizeof *out->frames, compare_frames);
+    vf_free_names(names, count);
     return status;
 }
 

@@ -36,6 +36,11 @@ vf_status vf_read_file(const char *path, char **data, size_t *size);
 vf_status vf_write_file_atomic(const char *path, const void *data, size_t size);
 vf_status vf_copy_file(const char *src, const char *dst);
 
+/* The JPEG and PNG file names (.jpg, .jpeg, .png, any case; no hidden files) in a folder,
+ * sorted by name, in *names (count of them, possibly 0). Free with vf_free_names. */
+vf_status vf_list_images(const char *folder, char ***names, int *count);
+void vf_free_names(char **names, int count);
+
 #ifdef __cplusplus
 }
 #endif
