@@ -2,7 +2,7 @@
 # `vfcapture attack` and `transfer` at the command line: help, and bad input (unknown label,
 # missing model, no trained field, malformed options) that fails with exit 1 and one clear
 # line while the workspace stays exactly as it was.
-source "$(dirname "$0")/cli_lib.sh"
+source "$(dirname "$0")/shell_checks.sh"
 
 chair="$shared/data/nerf_synthetic/chair/transforms_train.json"
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # vfcapture calib from the command line: printable patterns, the clear errors of intrinsics
 # and scale, and bad input that leaves a workspace as it was.
-source "$(dirname "$0")/cli_lib.sh"
+source "$(dirname "$0")/shell_checks.sh"
 
 expect 0 "calib help" -- "$tool" calib --help
 grep -q "usage: vfcapture calib" "$tmp/out" && ok || bad "calib --help prints its usage"

@@ -2,7 +2,7 @@
 # `vfcapture classify` as a user meets it: top-5 text and JSON, a label set with its accuracy,
 # and bad input (missing image, not an image, not a model, unknown class) failing with one
 # line and exit 1.
-source "$(dirname "$0")/cli_lib.sh"
+source "$(dirname "$0")/shell_checks.sh"
 
 samples="$shared/data/imagenet_samples"
 tench="$samples/000_n01440764.jpg"

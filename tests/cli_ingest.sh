@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The command line as a user meets it: help everywhere, exit codes, JSON output, and bad
 # input that leaves the workspace as it was.
-source "$(dirname "$0")/cli_lib.sh"
+source "$(dirname "$0")/shell_checks.sh"
 
 chair="$shared/data/nerf_synthetic/chair/transforms_train.json"
 

@@ -3,7 +3,7 @@
 # summary, the stage's shape (images/ and report.json, no transforms.json), and bad input
 # (not a video, an empty video, an empty folder, a missing or unsuitable camera) failing
 # with one line, exit 1, and the earlier workspace untouched.
-source "$(dirname "$0")/cli_lib.sh"
+source "$(dirname "$0")/shell_checks.sh"
 
 fox="$shared/data/real_captures/instant_ngp_fox/images"
 spray="$shared/data/real_captures/spray_can_photoroom/images"

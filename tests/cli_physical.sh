@@ -1,7 +1,7 @@
 # The physical-loop commands (export, localize, reshoot, score) on bad input: exit 1 and one
 # clear line saying what to do, and nothing written. (Their work on real data is checked by
 # tests/test_data_physical.c.)
-source "$VF_SOURCE_DIR/tests/cli_lib.sh"
+source "$VF_SOURCE_DIR/tests/shell_checks.sh"
 fox="$shared/data/real_captures/instant_ngp_fox/images/0001.jpg"
 mkdir -p "$tmp/ws"
 echo '{"stages": {}}' >"$tmp/ws/manifest.json"

@@ -2,7 +2,7 @@
 # `vfcapture poses` bad input as a user meets it: each mistake ends with one line naming it,
 # exit 1, and the workspace exactly as it was (no COLMAP run needed: these are caught first).
 # The expensive failures (a video COLMAP cannot register) are in test_data_poses_video.c.
-source "$(dirname "$0")/cli_lib.sh"
+source "$(dirname "$0")/shell_checks.sh"
 
 spray="$shared/data/real_captures/spray_can_photoroom/images"
 export TMPDIR="$tmp" # where a failed run keeps COLMAP's log

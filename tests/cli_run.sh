@@ -3,7 +3,7 @@
 # export), a second `run` that finds every stage up to date, `render` and `eval` of the
 # trained field, a benchmark set built and scored by two models, and bad input to those
 # commands failing with one line while the workspace stays as it was.
-source "$(dirname "$0")/cli_lib.sh"
+source "$(dirname "$0")/shell_checks.sh"
 
 chair="$shared/data/nerf_synthetic/chair"
 ws="$tmp/chair"

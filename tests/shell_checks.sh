@@ -1,6 +1,6 @@
-# Shared by the tests/cli_*.sh scripts: source it first. Sets $tool, $shared and a scratch
-# folder $tmp (removed on exit), and gives small assertion helpers that count passes and
-# failures; end a script with `cli_finish`.
+# Shared by the tests/cli_*.sh scripts (not a test itself): source it first. Sets $tool,
+# $shared and a scratch folder $tmp (removed on exit), and gives small assertion helpers that
+# count passes and failures; end a script with `cli_finish`.
 set -u
 tool="${VF_TOOL:?}"
 shared="${VF_SHARED_DIR:?}"
