@@ -231,7 +231,7 @@ vf_status vf_list_images(const char *folder, char ***names, int *count)
         vf_free_names(*names, *count);
         *names = NULL;
         *count = 0;
-    } else {
+    } else if (*count > 1) {
         qsort(*names, (size_t)*count, sizeof **names, compare_names);
     }
     return status;
