@@ -1,8 +1,9 @@
-/* The checkerboard: its corner layout, a printable image, and the set of views it was found
- * in (vf/calib.h). */
+/* The board: its corner layout, a printable image (ChArUco: drawn by OpenCV), and the set of
+ * views it was found in (vf/calib.h). */
 #include <stdlib.h>
 #include <string.h>
 
+#include "../src/opencv/calib_cv.h"
 #include "calib_internal.h"
 
 int vf_calib_board_corners(const vf_calib_board *board)
@@ -25,6 +26,8 @@ vf_status vf_calib_board_image(const vf_calib_board *board, int square_px, vf_rg
 {
     if (board->cols < 2 || board->rows < 2 || square_px < 1)
         return vf_fail(VF_EINPUT, "a board needs at least 2 x 2 inner corners");
+    if (board->marker > 0)
+        return vf_cv_charuco_image(board, square_px, out);
     int squares_x = board->cols + 1, squares_y = board->rows + 1;
     int width = (squares_x + 2) * square_px, height = (squares_y + 2) * square_px;
     vf_status status = vf_rgb8_resize_buffer(out, width, height);
@@ -41,7 +44,7 @@ vf_status vf_calib_board_image(const vf_calib_board *board, int square_px, vf_rg
 }
 
 vf_status vf_calib_views_add(vf_calib_views *set, int width, int height, const char *name,
-                             const double *uv, int corners)
+                             const double *uv, const double quad[8], int corners)
 {
     if (set->count == 0 && set->width == 0) {
         set->width = width;
@@ -65,6 +68,7 @@ vf_status vf_calib_views_add(vf_calib_views *set, int width, int height, const c
     if (!view->uv)
         return vf_fail(VF_EINTERNAL, "out of memory");
     memcpy(view->uv, uv, (size_t)corners * 2 * sizeof *uv);
+    memcpy(view->quad, quad, sizeof view->quad);
     snprintf(view->name, sizeof view->name, "%s", name);
     set->count++;
     return VF_OK;

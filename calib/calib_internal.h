@@ -10,8 +10,7 @@ double *calib_board_points(const vf_calib_board *board);
 
 /* Choose at most max of the views, spread over position, size and tilt of the board in the
  * frame (greedy farthest-point). chosen gets their indices; returns how many. */
-int calib_select_views(const vf_calib_views *set, const vf_calib_board *board, int max,
-                       int *chosen);
+int calib_select_views(const vf_calib_views *set, int max, int *chosen);
 
 /* RMS reprojection error of one view: board points through pose (rotation vector,
  * translation) and cam, against uv. */

@@ -27,6 +27,9 @@ vf_status vf_calib_save_camera(const char *path, const vf_calib_result *res,
         res->outliers, "boards_found", set->count, "frames_searched", set->frames_seen, "board",
         "cols", board->cols, "rows", board->rows, "square_m", board->square, "per_view",
         per_view);
+    if (doc && board->marker > 0)
+        json_object_set_new(json_object_get(doc, "board"), "charuco_marker_m",
+                            json_real(board->marker));
     if (!doc)
         return vf_fail(VF_EINTERNAL, "out of memory");
     vf_status status = vf_json_save(path, doc);

@@ -23,6 +23,7 @@ static vf_status list_images(const char *folder, char ***names, int *count)
 typedef struct photo_result {
     vf_status status;
     int found, width, height;
+    double quad[8];
     char message[256];
 } photo_result;
 
@@ -36,7 +37,7 @@ static void search_photo(const char *folder, const char *name, const vf_calib_bo
         r->status = vf_rgb8_load(path, &img);
     if (r->status == VF_OK) {
         r->width = img.width, r->height = img.height;
-        r->status = vf_calib_find_board(&img, board, uv, &r->found);
+        r->status = vf_calib_find_board(&img, board, uv, r->quad, &r->found);
     }
     if (r->status != VF_OK) /* the message is per thread: keep it for the caller */
         snprintf(r->message, sizeof r->message, "%s", vf_error_message());
@@ -72,7 +73,7 @@ vf_status vf_calib_collect_folder(const char *folder, const vf_calib_board *boar
             status = vf_fail(results[i].status, "%s", results[i].message);
         else if (results[i].found)
             status = vf_calib_views_add(out, results[i].width, results[i].height, names[i],
-                                        uv + (size_t)i * corners * 2, corners);
+                                        uv + (size_t)i * corners * 2, results[i].quad, corners);
     }
     vf_free_names(names, count);
     free(uv);
@@ -99,6 +100,7 @@ vf_status vf_calib_collect_video(const char *path, const vf_calib_board *board, 
         status = vf_fail(VF_EINTERNAL, "out of memory");
     for (long index = 0; status == VF_OK && out->frames_seen < max_frames; index++) {
         int got, found;
+        double quad[8];
         if (index % step) {
             status = vf_video_skip(video, &got);
             if (!got)
@@ -108,11 +110,11 @@ vf_status vf_calib_collect_video(const char *path, const vf_calib_board *board, 
         if ((status = vf_video_read(video, &frame, &got)) != VF_OK || !got)
             break;
         out->frames_seen++;
-        status = vf_calib_find_board(&frame, board, uv, &found);
+        status = vf_calib_find_board(&frame, board, uv, quad, &found);
         if (status == VF_OK && found) {
             char name[64];
             snprintf(name, sizeof name, "frame %ld", index);
-            status = vf_calib_views_add(out, frame.width, frame.height, name, uv, corners);
+            status = vf_calib_views_add(out, frame.width, frame.height, name, uv, quad, corners);
         }
         char note[48];
         snprintf(note, sizeof note, "%d boards", out->count);
@@ -150,14 +152,15 @@ vf_status vf_calib_collect_camera(const char *device, const vf_v4l2_ops *ops,
     while (status == VF_OK && vf_now() - start < seconds) {
         uint32_t sequence;
         int found;
+        double quad[8];
         status = vf_v4l2_read(cam, CAMERA_TIMEOUT_MS, &frame, &sequence);
         if (status == VF_OK)
-            status = vf_calib_find_board(&frame, board, uv, &found);
+            status = vf_calib_find_board(&frame, board, uv, quad, &found);
         out->frames_seen++;
         if (status == VF_OK && found) {
             char name[64];
             snprintf(name, sizeof name, "frame %u", (unsigned)sequence);
-            status = vf_calib_views_add(out, frame.width, frame.height, name, uv, corners);
+            status = vf_calib_views_add(out, frame.width, frame.height, name, uv, quad, corners);
         }
         char note[48];
         snprintf(note, sizeof note, "%d boards", out->count);

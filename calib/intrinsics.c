@@ -20,8 +20,12 @@ double calib_view_rms(const vf_camera *cam, const double pose[6], const double *
                       const double *uv, int corners)
 {
     double rot[9], sum = 0;
+    int seen = 0;
     vf_rot_from_axis_angle(pose, rot);
     for (int i = 0; i < corners; i++) {
+        if (isnan(uv[2 * i]))
+            continue; /* not seen in this view */
+        seen++;
         double board[3] = {object_xy[2 * i], object_xy[2 * i + 1], 0}, p[3], u, v;
         vf_mat3_apply(rot, board, p);
         for (int k = 0; k < 3; k++)
@@ -30,7 +34,7 @@ double calib_view_rms(const vf_camera *cam, const double pose[6], const double *
             return 1e9; /* behind the camera: as wrong as it gets */
         sum += (u - uv[2 * i]) * (u - uv[2 * i]) + (v - uv[2 * i + 1]) * (v - uv[2 * i + 1]);
     }
-    return sqrt(sum / corners);
+    return seen ? sqrt(sum / seen) : 0.0;
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -42,7 +46,6 @@ static int compare_doubles(const void *a, const void *b)
 /* The calibration in progress: the views in use and their poses. */
 typedef struct solve_state {
     vf_calib_views *set;
-    const vf_calib_board *board;
     double *object_xy;
     int corners;
     int *used; /* indices into set->views */
@@ -99,7 +102,7 @@ static int drop_outliers(solve_state *s, const vf_calib_options *opt)
 
 static vf_status solve(solve_state *s, const vf_calib_options *opt, vf_calib_result *out)
 {
-    s->count = calib_select_views(s->set, s->board, opt->max_views, s->used);
+    s->count = calib_select_views(s->set, opt->max_views, s->used);
     for (int k = 0; k < s->count; k++)
         s->uv[k] = s->set->views[s->used[k]].uv;
     double start = vf_now();
@@ -148,7 +151,7 @@ vf_status vf_calib_solve(vf_calib_views *set, const vf_calib_board *board,
     for (int i = 0; i < set->count; i++)
         set->views[i].state = VF_VIEW_SPARE, set->views[i].rms = 0;
     int max = opt->max_views < set->count ? opt->max_views : set->count;
-    solve_state s = {.set = set, .board = board, .corners = vf_calib_board_corners(board)};
+    solve_state s = {.set = set, .corners = vf_calib_board_corners(board)};
     s.object_xy = calib_board_points(board);
     s.used = malloc((size_t)max * sizeof *s.used);
     s.uv = malloc((size_t)max * sizeof *s.uv);

@@ -15,11 +15,9 @@ static double dist2(const double *a, const double *b)
 }
 
 /* Centre (2), apparent size and tilt (2) of the board's outer quad, all about 0..1. */
-static void view_features(const vf_calib_views *set, const vf_calib_board *board,
-                          const double *uv, double f[FEATURES])
+static void view_features(const vf_calib_views *set, const double quad[8], double f[FEATURES])
 {
-    int c = board->cols, r = board->rows;
-    const double *q[4] = {uv + 0, uv + 2 * (c - 1), uv + 2 * (r * c - 1), uv + 2 * (r - 1) * c};
+    const double *q[4] = {quad, quad + 2, quad + 4, quad + 6};
     double area = 0;
     f[0] = f[1] = 0;
     for (int k = 0; k < 4; k++) {
@@ -37,8 +35,7 @@ static void view_features(const vf_calib_views *set, const vf_calib_board *board
     f[4] = 2.0 * (bottom - top) / (bottom + top + 1e-9);
 }
 
-int calib_select_views(const vf_calib_views *set, const vf_calib_board *board, int max,
-                       int *chosen)
+int calib_select_views(const vf_calib_views *set, int max, int *chosen)
 {
     int n = set->count;
     if (n <= max) {
@@ -55,7 +52,7 @@ int calib_select_views(const vf_calib_views *set, const vf_calib_board *board, i
     }
     double mean[FEATURES] = {0};
     for (int i = 0; i < n; i++) {
-        view_features(set, board, set->views[i].uv, f + FEATURES * i);
+        view_features(set, set->views[i].quad, f + FEATURES * i);
         for (int k = 0; k < FEATURES; k++)
             mean[k] += f[FEATURES * i + k] / n;
     }

@@ -18,11 +18,15 @@ static const char usage[] =
     "'vfcapture poses --camera FILE' uses. Film the whole board from many directions: tilted\n"
     "left, right, up and down, near the frame's corners and edges, with the same zoom and\n"
     "focus as the capture. 'vfcapture calib board' writes a board to print.\n"
+    "A ChArUco board (--charuco) also counts views that show only part of it.\n"
     "\n"
     "options:\n"
     "      --board CxR        inner corners (where four squares meet), e.g. 9x6 for a board\n"
     "                         of 10 x 7 squares\n"
     "      --square MM        side of one square in millimetres (measure the print)\n"
+    "      --charuco MM       the board is a ChArUco board whose markers have this side\n"
+    "      --dict NAME        ChArUco: the markers' ArUco dictionary, OpenCV's DICT_* name\n"
+    "                         without the prefix (default 6x6_250)\n"
     "  -o, --output FILE      the camera file (default camera.json)\n"
     "      --v4l2 DEV         calibrate a webcam live instead of VIDEO or DIR\n"
     "      --seconds S        webcam: how long to capture (default 30)\n"
@@ -33,6 +37,8 @@ static const char usage[] =
 enum {
     OPT_BOARD = CLI_OPT_FIRST_CUSTOM,
     OPT_SQUARE,
+    OPT_CHARUCO,
+    OPT_DICT,
     OPT_V4L2,
     OPT_SECONDS,
     OPT_FRAMES,
@@ -57,6 +63,10 @@ static vf_status parse_option(int c, const char *arg, intrinsics_args *a)
         return calib_parse_board(arg, &a->board);
     case OPT_SQUARE:
         return calib_parse_mm(arg, "--square", &a->board.square);
+    case OPT_CHARUCO:
+        return calib_parse_mm(arg, "--charuco", &a->board.marker);
+    case OPT_DICT:
+        return vf_charuco_dictionary(arg, &a->board.dictionary);
     case 'o':
         a->output = arg;
         return VF_OK;
@@ -89,6 +99,8 @@ static vf_status parse_args(int argc, char **argv, intrinsics_args *a, cli_flags
         CLI_COMMON_OPTIONS,
         {"board", required_argument, NULL, OPT_BOARD},
         {"square", required_argument, NULL, OPT_SQUARE},
+        {"charuco", required_argument, NULL, OPT_CHARUCO},
+        {"dict", required_argument, NULL, OPT_DICT},
         {"output", required_argument, NULL, 'o'},
         {"v4l2", required_argument, NULL, OPT_V4L2},
         {"seconds", required_argument, NULL, OPT_SECONDS},
@@ -99,11 +111,12 @@ static vf_status parse_args(int argc, char **argv, intrinsics_args *a, cli_flags
     };
     *a = (intrinsics_args){.output = "camera.json", .seconds = 30, .frames = 200};
     vf_calib_defaults(&a->calib);
+    vf_status status = vf_charuco_dictionary(CALIB_DEFAULT_DICTIONARY, &a->board.dictionary);
     int c;
     while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "o:", longopts, NULL)) != -1) {
         if (cli_common_option(c, flags, "calib intrinsics", usage))
             continue;
-        vf_status status = parse_option(c, optarg, a);
+        status = parse_option(c, optarg, a);
         if (status != VF_OK)
             return status;
     }
@@ -118,6 +131,8 @@ static vf_status parse_args(int argc, char **argv, intrinsics_args *a, cli_flags
                                   "--board 9x6");
     if (!(a->board.square > 0))
         return vf_fail(VF_EINPUT, "give the side of one square with --square MM");
+    if (a->board.marker >= a->board.square)
+        return vf_fail(VF_EINPUT, "--charuco: the marker side must be below the square side");
     if (a->calib.min_views > a->calib.max_views)
         return vf_fail(VF_EINPUT, "--min-views is above --max-views");
     return VF_OK;

@@ -11,12 +11,13 @@ static const char usage[] =
     "usage: vfcapture calib <intrinsics|scale|board|marker> [options]\n"
     "\n"
     "  intrinsics (VIDEO | DIR | --v4l2 DEV) --board COLSxROWS --square MM [-o camera.json]\n"
-    "             calibrate a camera from views of a checkerboard; the camera file feeds\n"
+    "             calibrate a camera from views of a checkerboard (or ChArUco board,\n"
+    "             --charuco MM); the camera file feeds\n"
     "             'vfcapture poses --camera'\n"
     "  scale WS (--marker ID --size MM | --distance P1 P2 MM)\n"
     "             give a posed workspace metric scale (WS/calib/scale.json)\n"
-    "  board --board COLSxROWS -o board.png [--square-px N]\n"
-    "             write a printable checkerboard\n"
+    "  board --board COLSxROWS -o board.png [--square-px N] [--charuco [--dict NAME]]\n"
+    "             write a printable checkerboard or ChArUco board\n"
     "  marker --id ID -o marker.png [--cell-px N]\n"
     "             write a printable ArUco marker (original dictionary, ids 0..1023)\n"
     "\n"
@@ -49,7 +50,7 @@ vf_status calib_parse_mm(const char *text, const char *what, double *metres)
     return VF_OK;
 }
 
-enum { OPT_BOARD = CLI_OPT_FIRST_CUSTOM, OPT_ID, OPT_PX };
+enum { OPT_BOARD = CLI_OPT_FIRST_CUSTOM, OPT_ID, OPT_PX, OPT_CHARUCO, OPT_DICT };
 
 /* `calib board` and `calib marker`: write a printable pattern. */
 static int print_pattern(int argc, char **argv, int marker)
@@ -68,31 +69,37 @@ static int print_pattern(int argc, char **argv, int marker)
                              "  -o, --output FILE the PNG to write\n"
                              "      --cell-px N   pixels per cell (default 40)\n" CLI_COMMON_HELP
                            : "usage: vfcapture calib board --board COLSxROWS -o FILE.png "
-                             "[--square-px N]\n"
+                             "[--square-px N] [--charuco [--dict NAME]]\n"
                              "\n"
                              "Write a checkerboard with COLSxROWS inner corners ((COLS+1) x\n"
                              "(ROWS+1) squares) as a PNG, with a white margin. Print it flat and\n"
-                             "measure one square for 'calib intrinsics --square'.\n"
+                             "measure one square for 'calib intrinsics --square' (and, on a\n"
+                             "ChArUco board, one marker for --charuco: 3/4 of the square).\n"
                              "\n"
                              "options:\n"
                              "      --board CxR   inner corners, e.g. 9x6\n"
                              "  -o, --output FILE the PNG to write\n"
-                             "      --square-px N pixels per square (default 100)\n" CLI_COMMON_HELP;
+                             "      --square-px N pixels per square (default 100)\n"
+                             "      --charuco     put ArUco markers in the white squares\n"
+                             "      --dict NAME   their dictionary (default " CALIB_DEFAULT_DICTIONARY
+                             ")\n" CLI_COMMON_HELP;
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
         {"board", required_argument, NULL, OPT_BOARD},
         {"id", required_argument, NULL, OPT_ID},
         {"square-px", required_argument, NULL, OPT_PX},
         {"cell-px", required_argument, NULL, OPT_PX},
+        {"charuco", no_argument, NULL, OPT_CHARUCO},
+        {"dict", required_argument, NULL, OPT_DICT},
         {"output", required_argument, NULL, 'o'},
         {0, 0, 0, 0},
     };
     cli_flags flags = {0};
-    vf_calib_board board = {0, 0, 1};
+    vf_calib_board board = {0, 0, 1, 0, 0};
     const char *output = NULL;
     long id = -1, px = marker ? 40 : 100;
     int c;
-    vf_status status = VF_OK;
+    vf_status status = vf_charuco_dictionary(CALIB_DEFAULT_DICTIONARY, &board.dictionary);
     while (status == VF_OK &&
            (c = getopt_long(argc, argv, CLI_COMMON_SHORT "o:", longopts, NULL)) != -1) {
         if (cli_common_option(c, &flags, name, help))
@@ -101,12 +108,16 @@ static int print_pattern(int argc, char **argv, int marker)
             output = optarg;
         else if (c == OPT_BOARD && !marker)
             status = calib_parse_board(optarg, &board);
+        else if (c == OPT_CHARUCO && !marker)
+            board.marker = VF_CHARUCO_MARKER_RATIO * board.square;
+        else if (c == OPT_DICT && !marker)
+            status = vf_charuco_dictionary(optarg, &board.dictionary);
         else if (c == OPT_ID && marker && cli_parse_int(optarg, 0, VF_ARUCO_IDS - 1, &id))
             status = vf_fail(VF_EINPUT, "--id: give an id from 0 to %d", VF_ARUCO_IDS - 1);
         else if (c == OPT_PX && cli_parse_int(optarg, 4, 1000, &px))
             status = vf_fail(VF_EINPUT, "%s: give a number of pixels from 4 to 1000",
                              marker ? "--cell-px" : "--square-px");
-        else if ((c == OPT_BOARD && marker) || (c == OPT_ID && !marker))
+        else if (marker ? c == OPT_BOARD || c == OPT_CHARUCO || c == OPT_DICT : c == OPT_ID)
             status = vf_fail(VF_EINPUT, "see 'vfcapture %s --help' for the options", name);
     }
     if (status == VF_OK && (optind != argc || !output))

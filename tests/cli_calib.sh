@@ -15,6 +15,10 @@ one_line_naming "unknown subcommand" "frobnicate"
 # Printable board and marker.
 expect 0 "board" -- "$tool" calib board --board 9x6 --square-px 20 -o "$tmp/board.png" --quiet
 [ -s "$tmp/board.png" ] && ok || bad "board.png written"
+expect 0 "charuco board" -- "$tool" calib board --board 7x5 --charuco --dict 4x4_50 -o "$tmp/charuco.png" --quiet
+[ -s "$tmp/charuco.png" ] && ok || bad "charuco.png written"
+expect 1 "unknown dictionary" -- "$tool" calib board --board 7x5 --charuco --dict 9x9_5 -o "$tmp/c.png"
+one_line_naming "unknown dictionary" "9x9_5"
 expect 0 "marker" -- "$tool" calib marker --id 5 -o "$tmp/marker.png" --json
 json_check "marker --json names the file" 'd["output"].endswith("marker.png")'
 expect 1 "marker id range" -- "$tool" calib marker --id 5000 -o "$tmp/m.png"
@@ -30,6 +34,13 @@ expect 1 "too few boards" -- "$tool" calib intrinsics "$tmp/views" --board 9x6 -
   -o "$tmp/cam.json" --quiet
 one_line_naming "too few boards" "found in only 1 of 1 frames"
 [ ! -e "$tmp/cam.json" ] && ok || bad "no camera file after a failure"
+mkdir -p "$tmp/charuco_views" && cp "$tmp/charuco.png" "$tmp/charuco_views/a.png"
+expect 1 "too few ChArUco boards" -- "$tool" calib intrinsics "$tmp/charuco_views" --board 7x5 \
+  --square 40 --charuco 30 --dict 4x4_50 -o "$tmp/cam.json" --quiet
+one_line_naming "too few ChArUco boards" "found in only 1 of 1 frames"
+expect 1 "marker larger than square" -- "$tool" calib intrinsics "$tmp/charuco_views" --board 7x5 \
+  --square 40 --charuco 45
+one_line_naming "marker larger than square" "--charuco"
 expect 1 "missing input" -- "$tool" calib intrinsics "$tmp/nope.mp4" --board 9x6 --square 25
 one_line_naming "missing input" "nope.mp4"
 

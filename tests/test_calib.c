@@ -24,13 +24,16 @@ static void tilt(double ax, double ay, double roll, double rot[9])
     vf_mat3_mul(rz, tmp, rot);
 }
 
-/* Render the board at view k of n: tilted every way, at several distances and offsets. */
-static vf_status board_view(const vf_rgb8 *texture, double texel, int k, vf_rgb8 *out)
+/* Render the board at view k: tilted every way, at several distances and offsets (the board's
+ * centre moves up to `shift` metres off the optical axis, at about `distance` metres). */
+static vf_status board_view(const vf_rgb8 *texture, double texel, int k, double shift,
+                            double distance, vf_rgb8 *out)
 {
     double a = 2 * M_PI * k / 7.0, rot[9], t[3], centre[3] = {0.5 * texture->width * texel,
                                                            0.5 * texture->height * texel, 0};
     tilt(0.6 * sin(a), 0.6 * cos(a), 0.3 * sin(3.0 * k), rot);
-    double in_camera[3] = {0.07 * cos(1.7 * k), 0.05 * sin(2.3 * k), 0.55 + 0.1 * sin(0.9 * k)};
+    double in_camera[3] = {shift * cos(1.7 * k), 0.7 * shift * sin(2.3 * k),
+                           distance + 0.1 * sin(0.9 * k)};
     double rc[3];
     vf_mat3_apply(rot, centre, rc);
     for (int i = 0; i < 3; i++)
@@ -40,7 +43,7 @@ static vf_status board_view(const vf_rgb8 *texture, double texel, int k, vf_rgb8
 
 static void test_intrinsics(void)
 {
-    vf_calib_board board = {9, 6, 0.03};
+    vf_calib_board board = {9, 6, 0.03, 0, 0};
     vf_rgb8 texture = {0}, img = {0};
     const int square_px = 24, views = 14;
     CHECK(vf_calib_board_image(&board, square_px, &texture) == VF_OK, "%s", vf_error_message());
@@ -49,14 +52,18 @@ static void test_intrinsics(void)
     double start = vf_now();
     for (int k = 0; k < views; k++) {
         int found = 0;
-        CHECK(board_view(&texture, texel, k, &img) == VF_OK, "%s", vf_error_message());
-        CHECK(vf_calib_find_board(&img, &board, uv, &found) == VF_OK, "%s", vf_error_message());
+        double quad[8];
+        CHECK(board_view(&texture, texel, k, 0.07, 0.55, &img) == VF_OK, "%s",
+              vf_error_message());
+        CHECK(vf_calib_find_board(&img, &board, uv, quad, &found) == VF_OK, "%s",
+              vf_error_message());
         CHECK(found, "board found in view %d", k);
         set.frames_seen++, few.frames_seen++;
         if (found) {
-            CHECK(vf_calib_views_add(&set, img.width, img.height, "view", uv, 54) == VF_OK, "add");
+            CHECK(vf_calib_views_add(&set, img.width, img.height, "view", uv, quad, 54) == VF_OK,
+                  "add");
             if (few.count < 3)
-                vf_calib_views_add(&few, img.width, img.height, "view", uv, 54);
+                vf_calib_views_add(&few, img.width, img.height, "view", uv, quad, 54);
         }
     }
     printf("render + search: %.1f ms per view\n", 1000 * (vf_now() - start) / views);
@@ -65,7 +72,9 @@ static void test_intrinsics(void)
     int found = 1;
     vf_rgb8_resize_buffer(&blank, 320, 240);
     memset(blank.data, 128, 320 * 240 * 3);
-    CHECK(vf_calib_find_board(&blank, &board, uv, &found) == VF_OK && !found, "blank frame");
+    double quad[8];
+    CHECK(vf_calib_find_board(&blank, &board, uv, quad, &found) == VF_OK && !found,
+          "blank frame");
 
     vf_calib_options opt;
     vf_calib_defaults(&opt);
@@ -105,6 +114,63 @@ static void test_intrinsics(void)
     vf_rgb8_free(&img);
     vf_rgb8_free(&blank);
     free(uv);
+}
+
+/* A ChArUco board pushed partly out of the frame: views that show only some corners count,
+ * and give the lens back as well as whole checkerboards do. */
+static void test_charuco(void)
+{
+    vf_calib_board board = {7, 5, 0.04, 0.03, 0};
+    CHECK(vf_charuco_dictionary("4X4_50", &board.dictionary) == VF_OK, "%s", vf_error_message());
+    CHECK(vf_charuco_dictionary("5x5_7", &board.dictionary) == VF_EINPUT &&
+              strstr(vf_error_message(), "5x5_7"),
+          "unknown dictionary named");
+    vf_charuco_dictionary("4x4_50", &board.dictionary);
+    vf_rgb8 texture = {0}, img = {0};
+    const int square_px = 64, views = 14, corners = 35;
+    CHECK(vf_calib_board_image(&board, square_px, &texture) == VF_OK, "%s", vf_error_message());
+    double texel = board.square / square_px, uv[2 * 35], quad[8];
+    vf_calib_views set = {0};
+    int partial = 0;
+    for (int k = 0; k < views; k++) {
+        int found = 0;
+        CHECK(board_view(&texture, texel, k, 0.2, 0.45, &img) == VF_OK, "%s", vf_error_message());
+        CHECK(vf_calib_find_board(&img, &board, uv, quad, &found) == VF_OK, "%s",
+              vf_error_message());
+        set.frames_seen++;
+        if (!found)
+            continue;
+        int seen = 0;
+        for (int i = 0; i < corners; i++)
+            seen += !isnan(uv[2 * i]);
+        partial += seen < corners;
+        CHECK(vf_calib_views_add(&set, img.width, img.height, "view", uv, quad, corners) == VF_OK,
+              "add");
+    }
+    printf("ChArUco: found in %d of %d views, %d of them partial\n", set.count, views, partial);
+    CHECK(set.count >= views - 2, "ChArUco board found in %d of %d views", set.count, views);
+    CHECK(partial >= 3, "only %d partial views: the test should push the board out", partial);
+
+    vf_calib_options opt;
+    vf_calib_defaults(&opt);
+    vf_calib_result res;
+    CHECK(vf_calib_solve(&set, &board, &opt, &res) == VF_OK, "%s", vf_error_message());
+    const vf_camera *c = &res.camera;
+    printf("ChArUco: fx %.2f fy %.2f cx %.2f cy %.2f k1 %.4f rms %.3f px, %d views\n", c->fx,
+           c->fy, c->cx, c->cy, c->k1, res.rms, res.used);
+    CHECK_NEAR(c->fx, lens.fx, 0.005 * lens.fx);
+    CHECK_NEAR(c->fy, lens.fy, 0.005 * lens.fy);
+    CHECK_NEAR(c->cx, lens.cx, 2.0);
+    CHECK_NEAR(c->cy, lens.cy, 2.0);
+    CHECK(res.rms < 0.5, "rms %.3f px", res.rms);
+
+    /* more markers than the dictionary has codes: refused, not drawn wrong */
+    vf_calib_board big = {19, 14, 0.02, 0.015, board.dictionary};
+    CHECK(vf_calib_board_image(&big, 8, &img) == VF_EINPUT && strstr(vf_error_message(), "--dict"),
+          "a 20 x 15 board with 4x4_50 refused: %s", vf_error_message());
+    vf_calib_views_free(&set);
+    vf_rgb8_free(&texture);
+    vf_rgb8_free(&img);
 }
 
 static void test_picks_parse(void)
@@ -285,6 +351,7 @@ int main(void)
     vf_log_set_quiet(1);
     test_picks_parse();
     test_intrinsics();
+    test_charuco();
     test_scale();
     return check_finish();
 }

@@ -1,10 +1,12 @@
-/* vf/calib.h: camera calibration from a checkerboard, and metric scale for a workspace.
+/* vf/calib.h: camera calibration from a checkerboard or ChArUco board, and metric scale for a
+ * workspace.
  *
- * Intrinsics: frames that show a planar checkerboard of known square size are searched for its
- * inner corners (OpenCV, src/opencv/calib_cv.cpp); well-spread views are kept; OpenCV's
- * calibrateCamera gives the first estimate of the OPENCV lens (fx, fy, cx, cy, k1, k2, p1, p2,
- * as COLMAP and vf/camera.h use it); views that reproject badly are dropped; Ceres then refines
- * lens and board poses together under a robust (Huber) loss (src/ceres/calib_refine.cpp).
+ * Intrinsics: frames that show a planar checkerboard (or ChArUco board) of known square size
+ * are searched for its inner corners (OpenCV, src/opencv/calib_cv.cpp and charuco_cv.cpp);
+ * well-spread views are kept; OpenCV's calibrateCamera gives the first estimate of the OPENCV
+ * lens (fx, fy, cx, cy, k1, k2, p1, p2, as COLMAP and vf/camera.h use it); views that
+ * reproject badly are dropped; Ceres then refines lens and board poses together under a robust
+ * (Huber) loss (src/ceres/calib_refine.cpp).
  * Pixel coordinates follow vf/camera.h: the image corner is (0, 0), pixel centres at +0.5.
  *
  * Scale: a workspace's scene units (object frame of WS/poses/transforms.json) are tied to
@@ -30,31 +32,49 @@
 extern "C" {
 #endif
 
-/* ---- the checkerboard ---- */
+/* ---- the board: a checkerboard, or a ChArUco board ----
+ *
+ * A ChArUco board is a checkerboard with an ArUco marker in each white square (OpenCV's
+ * aruco module). The markers name the corners around them, so a view that shows only part of
+ * the board still counts: corners it does not show are NaN in that view's uv. */
 
 typedef struct vf_calib_board {
     int cols, rows; /* inner corners (where four squares meet): a 10 x 7 squares board is 9 x 6 */
     double square;  /* side of one square, in the unit the poses should have (metres) */
+    double marker;  /* ChArUco: side of a marker, same unit; 0 for a plain checkerboard */
+    int dictionary; /* ChArUco: the markers' dictionary (vf_charuco_dictionary) */
 } vf_calib_board;
+
+#define VF_CHARUCO_MARKER_RATIO 0.75 /* marker side / square side on boards we print */
 
 /* Inner-corner count of a board: cols * rows. */
 int vf_calib_board_corners(const vf_calib_board *board);
 
-/* A printable board: (cols + 1) x (rows + 1) squares of square_px pixels, top-left square
- * black, with a white margin of one square all round. */
+/* The dictionary called name ("4x4_50", "5x5_100", "6x6_250", "aruco_original", ... as
+ * OpenCV's DICT_* names without the prefix, any case) for vf_calib_board.dictionary. */
+vf_status vf_charuco_dictionary(const char *name, int *dictionary);
+
+/* A printable board: (cols + 1) x (rows + 1) squares of square_px pixels with a white margin
+ * of one square all round; the top-left square is black. A ChArUco board (marker > 0) gets
+ * markers of VF_CHARUCO_MARKER_RATIO times the square in its white squares. */
 vf_status vf_calib_board_image(const vf_calib_board *board, int square_px, vf_rgb8 *out);
 
-/* Find the board's inner corners in a frame. *found is 1 when all of them were seen, and uv
- * (2 * cols * rows doubles, row by row) then holds their subpixel positions. */
+/* Find the board's inner corners in a frame; uv gets 2 * cols * rows doubles, row by row.
+ * *found is 1 when the view is usable: a checkerboard with every corner seen, or a ChArUco
+ * board with at least VF_CHARUCO_MIN_CORNERS corners (the others NaN). quad gets the board's
+ * four outer inner corners (first and last of the top row, last and first of the bottom row),
+ * where they are, or would be when hidden. */
+#define VF_CHARUCO_MIN_CORNERS 12
 vf_status vf_calib_find_board(const vf_rgb8 *frame, const vf_calib_board *board, double *uv,
-                              int *found);
+                              double quad[8], int *found);
 
 /* ---- intrinsics ---- */
 
 /* One frame in which the board was found. */
 typedef struct vf_calib_view {
     char name[128]; /* where it came from: a file name or "frame 123" */
-    double *uv;     /* 2 * corners pixel positions (owned) */
+    double *uv;     /* 2 * corners pixel positions (owned), NaN where a corner was not seen */
+    double quad[8]; /* the board's outer corners, as vf_calib_find_board gives them */
     double rms;     /* reprojection error of this view after calibration, pixels (0 unused) */
     int state;      /* VF_VIEW_* below */
 } vf_calib_view;
@@ -72,9 +92,9 @@ typedef struct vf_calib_views {
     int frames_seen;   /* frames searched, with or without a board */
 } vf_calib_views;
 
-/* Add a found board (uv is copied). The first call fixes the frame size. */
+/* Add a found board (uv and quad are copied). The first call fixes the frame size. */
 vf_status vf_calib_views_add(vf_calib_views *set, int width, int height, const char *name,
-                             const double *uv, int corners);
+                             const double *uv, const double quad[8], int corners);
 void vf_calib_views_free(vf_calib_views *set);
 
 /* Search frames for the board and add every view it is found in. A folder: its .jpg, .jpeg

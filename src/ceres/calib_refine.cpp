@@ -6,6 +6,7 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include <cmath>
 #include <new>
 
 namespace {
@@ -47,6 +48,8 @@ extern "C" vf_status vf_ceres_refine_calibration(vf_camera *cam, double *poses, 
         ceres::Problem problem;
         for (int v = 0; v < views; v++)
             for (int i = 0; i < corners; i++) {
+                if (std::isnan(uv[v][2 * i]))
+                    continue; // not seen in this view
                 auto *cost = new ceres::AutoDiffCostFunction<CornerError, 2, 8, 6>(
                     new CornerError{object_xy[2 * i], object_xy[2 * i + 1], uv[v][2 * i],
                                     uv[v][2 * i + 1]});

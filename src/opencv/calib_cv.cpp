@@ -1,5 +1,5 @@
 // The OpenCV side of the calibration (vf/calib.h, src/opencv/calib_cv.h): checkerboard
-// corners, calibrateCamera, and rendering a textured plane through a lens for synthetic views.
+// corners (ChArUco boards: charuco_cv.cpp), calibrateCamera, and rendering a textured plane through a lens for synthetic views.
 // Pixel coordinates cross this boundary in the vf/camera.h convention (pixel centres at +0.5);
 // OpenCV puts pixel centres at integers, so +-0.5 is applied here and nowhere else.
 #include "vf/calib.h"
@@ -40,8 +40,10 @@ double min_corner_spacing(const std::vector<cv::Point2f> &pts, int cols, int row
 } // namespace
 
 extern "C" vf_status vf_calib_find_board(const vf_rgb8 *frame, const vf_calib_board *board,
-                                         double *uv, int *found)
+                                         double *uv, double quad[8], int *found)
 {
+    if (board->marker > 0)
+        return vf_cv_find_charuco(frame, board, uv, quad, found);
     *found = 0;
     try {
         cv::Mat gray, small;
@@ -72,6 +74,11 @@ extern "C" vf_status vf_calib_find_board(const vf_rgb8 *frame, const vf_calib_bo
             uv[2 * i] = pts[i].x + 0.5;
             uv[2 * i + 1] = pts[i].y + 0.5;
         }
+        int c = board->cols, r = board->rows, outer[4] = {0, c - 1, r * c - 1, (r - 1) * c};
+        for (int k = 0; k < 4; k++) {
+            quad[2 * k] = uv[2 * outer[k]];
+            quad[2 * k + 1] = uv[2 * outer[k] + 1];
+        }
         *found = 1;
         return VF_OK;
     } catch (const cv::Exception &e) {
@@ -86,14 +93,15 @@ extern "C" vf_status vf_cv_calibrate(const double *object_xy, int corners, const
                                      double *poses)
 {
     try {
-        std::vector<cv::Point3f> board;
-        for (int i = 0; i < corners; i++)
-            board.emplace_back((float)object_xy[2 * i], (float)object_xy[2 * i + 1], 0.0f);
-        std::vector<std::vector<cv::Point3f>> object(views, board);
+        std::vector<std::vector<cv::Point3f>> object(views);
         std::vector<std::vector<cv::Point2f>> image(views);
         for (int v = 0; v < views; v++)
             for (int i = 0; i < corners; i++)
-                image[v].emplace_back((float)uv[v][2 * i], (float)uv[v][2 * i + 1]);
+                if (!std::isnan(uv[v][2 * i])) { // a corner this view saw
+                    object[v].emplace_back((float)object_xy[2 * i], (float)object_xy[2 * i + 1],
+                                           0.0f);
+                    image[v].emplace_back((float)uv[v][2 * i], (float)uv[v][2 * i + 1]);
+                }
         cv::Mat K, dist;
         std::vector<cv::Mat> rvecs, tvecs;
         int flags = cv::CALIB_FIX_K3; // COLMAP's OPENCV model: k1, k2, p1, p2
