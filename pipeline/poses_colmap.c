@@ -195,6 +195,55 @@ static void drop_stereo_files(const char *out_dir)
     }
 }
 
+/* The ingest frame behind COLMAP image `name` when it had an alpha channel, else NULL. */
+static const vf_sfm_frame *frame_with_alpha(const poses_run *run, const char *name)
+{
+    for (int i = 0; i < run->frames.count; i++)
+        if (run->frames.frames[i].had_alpha && !strcmp(run->frames.frames[i].name, name))
+            return &run->frames.frames[i];
+    return NULL;
+}
+
+/* Replace COLMAP's undistorted RGB of every frame that had alpha (a removed background) by
+ * the frame undistorted with its alpha, so that training knows where the object ends. */
+static vf_status restore_alpha(poses_run *run, const vf_colmap_model *undistorted,
+                               const char *image_dir)
+{
+    vf_status status = VF_OK;
+    vf_progress progress;
+    vf_progress_begin(&progress, "undistorting alpha", (size_t)undistorted->image_count,
+                      "images");
+    for (int i = 0; i < undistorted->image_count && status == VF_OK; i++) {
+        const vf_colmap_image *image = &undistorted->images[i];
+        const vf_sfm_frame *frame = frame_with_alpha(run, image->name);
+        const vf_colmap_image *original = vf_colmap_model_image(&run->model, image->id);
+        const vf_colmap_camera *from =
+            original ? vf_colmap_model_camera(&run->model, original->camera_id) : NULL;
+        const vf_colmap_camera *to = vf_colmap_model_camera(undistorted, image->camera_id);
+        if (!frame || !from || !to)
+            continue;
+        vf_camera lens, pinhole;
+        vf_image src = {0}, out = {0};
+        char path[VF_PATH_MAX];
+        status = vf_colmap_camera_to_vf(from, &lens);
+        if (status == VF_OK)
+            status = vf_colmap_camera_to_vf(to, &pinhole);
+        if (status == VF_OK)
+            status = vf_image_load(frame->source, &src);
+        if (status == VF_OK)
+            status = vf_sfm_undistort_frame(&src, &lens, &pinhole, &out);
+        if (status == VF_OK)
+            status = vf_path_join(path, sizeof path, image_dir, image->name);
+        if (status == VF_OK)
+            status = vf_image_save(path, &out);
+        vf_image_free(&src);
+        vf_image_free(&out);
+        vf_progress_update(&progress, (size_t)i + 1, NULL);
+    }
+    vf_progress_end(&progress);
+    return status;
+}
+
 vf_status poses_undistort(poses_run *run, vf_colmap_model *out)
 {
     char out_dir[VF_PATH_MAX], sparse[VF_PATH_MAX], txt[VF_PATH_MAX];
@@ -217,5 +266,9 @@ vf_status poses_undistort(poses_run *run, vf_colmap_model *out)
     if (status == VF_OK)
         status = vf_colmap_model_load(txt, out);
     drop_stereo_files(out_dir);
+    char image_dir[VF_PATH_MAX];
+    if (status == VF_OK && run->frames.with_alpha > 0 &&
+        (status = vf_path_join(image_dir, sizeof image_dir, out_dir, "images")) == VF_OK)
+        status = restore_alpha(run, out, image_dir);
     return status;
 }

@@ -12,7 +12,9 @@
 #ifndef VF_SFM_IMAGES_H
 #define VF_SFM_IMAGES_H
 
+#include "vf/camera.h"
 #include "vf/error.h"
+#include "vf/image.h"
 #include "vf/fsutil.h"
 
 #ifdef __cplusplus
@@ -41,6 +43,12 @@ vf_status vf_sfm_images_prepare(const char *src_dir, const char *dst_dir,
                                 const float background[3], vf_sfm_images *out);
 
 void vf_sfm_images_free(vf_sfm_images *images);
+
+/* Undistort a frame with all its channels (sfm_alpha.c): out gets the frame as the pinhole
+ * camera `pinhole` sees it, sampled bilinearly from src, which camera `lens` (with distortion)
+ * took; pixels that fall outside src are 0, so transparent. Uses every core. */
+vf_status vf_sfm_undistort_frame(const vf_image *src, const vf_camera *lens,
+                                 const vf_camera *pinhole, vf_image *out);
 
 #ifdef __cplusplus
 }

@@ -11,9 +11,9 @@
  *     world unit; colour = sigmoid(SH logits . basis(direction));
  *   - a ray is sampled every `step` world units; sample i gets alpha_i = 1 - exp(-sigma_i step)
  *     and the usual front-to-back compositing C = sum T_i alpha_i c_i + T_end * background;
- *   - an occupancy bitfield (one bit per cell, one byte per 8^3-cell block) says where density
- *     may be visible; the march jumps over empty blocks and skips empty cells, and stops when
- *     the transmittance T falls below a threshold (early termination).
+ *   - an occupancy bitfield (one bit per cell) says where density may be visible, and each
+ *     cell's distance to the nearest occupied cell lets the march jump over empty space; the
+ *     march stops when the transmittance T falls below a threshold (early termination).
  *
  * A field may have a second, coarser grid around the first (the background of a real scene);
  * a ray then marches the outer grid up to the inner box, the inner grid inside it, and the
@@ -32,7 +32,7 @@
 #define FIELD_CH_USED 13    /* density + 12 SH coefficients */
 #define FIELD_CH_DENSITY 0
 #define FIELD_CH_SH 1       /* colour k, SH basis b: FIELD_CH_SH + 4 * k + b */
-#define FIELD_BLOCK_SHIFT 3 /* occupancy blocks are 8^3 cells */
+#define FIELD_MAX_RADIUS 32 /* empty-space radii are counted up to this many cells */
 #define FIELD_MAX_GRIDS 2
 #define FIELD_EMPTY_DENSITY (-30.0f) /* raw density of carved-away space */
 /* Rendering skips samples below this opacity: together they carry about 0.5% of a ray's
@@ -49,8 +49,9 @@ typedef struct field_grid {
     float *values;     /* points * FIELD_CH floats, 64-byte aligned */
     int cells[3];      /* dim - 1: the trilinear cells */
     uint64_t *cell_bits; /* one bit per cell: 1 when the cell may hold visible density */
-    int blocks[3];     /* ceil(cells / 8) */
-    uint8_t *block_bits; /* one byte per block: 1 when any of its cells is occupied */
+    uint8_t *empty_radius; /* per cell: Chebyshev distance, in cells, to the nearest occupied
+                              cell (0 when occupied, at most FIELD_MAX_RADIUS): see
+                              empty_space.c */
     int occ_lo[3], occ_hi[3]; /* cells [occ_lo, occ_hi) hold every occupied cell (a tight box
                                  for clipping rays); occ_lo >= occ_hi when none is occupied */
 } field_grid;
@@ -91,6 +92,17 @@ void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_wo
 
 /* Set all occupancy bits (used before the densities mean anything). */
 void field_grid_fill_occupancy(field_grid *g);
+
+/* Recompute empty_radius from the occupancy bits; scratch holds one byte per cell. */
+void field_grid_update_empty_radius(field_grid *g, uint8_t *scratch);
+
+/* Samples a march may jump from a cell of empty-space radius r (> 0), for a ray moving
+ * cells_per_sample cells per sample along its fastest axis: it lands r - 1 cells away at most,
+ * so every sample jumped lies in an empty cell. */
+static inline int field_empty_jump(int radius, float samples_per_cell)
+{
+    return 1 + (int)((float)(radius - 1) * samples_per_cell * 0.999f); /* 0.999: rounding */
+}
 
 /* The raw density d at which a step of step_world reaches opacity `alpha`: alpha >= threshold
  * exactly when d >= the value returned (softplus is monotonic). */

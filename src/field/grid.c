@@ -37,16 +37,14 @@ vf_status field_grid_alloc(field_grid *g, const int dim[3], const float lo[3], f
         g->lo[a] = lo[a];
         g->hi[a] = lo[a] + (float)(dim[a] - 1) * voxel;
         g->cells[a] = dim[a] - 1;
-        g->blocks[a] = (g->cells[a] + (1 << FIELD_BLOCK_SHIFT) - 1) >> FIELD_BLOCK_SHIFT;
     }
     g->voxel = voxel;
     g->points = (size_t)dim[0] * dim[1] * dim[2];
     size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2];
-    size_t blocks = (size_t)g->blocks[0] * g->blocks[1] * g->blocks[2];
     g->values = field_alloc(g->points * FIELD_CH * sizeof(float));
     g->cell_bits = field_alloc(bit_words(cells) * sizeof(uint64_t));
-    g->block_bits = field_alloc(blocks);
-    if (!g->values || !g->cell_bits || !g->block_bits) {
+    g->empty_radius = field_alloc(cells);
+    if (!g->values || !g->cell_bits || !g->empty_radius) {
         field_grid_free(g);
         return vf_fail(VF_EINTERNAL, "out of memory for a %dx%dx%d grid", dim[0], dim[1], dim[2]);
     }
@@ -58,7 +56,7 @@ void field_grid_free(field_grid *g)
 {
     free(g->values);
     free(g->cell_bits);
-    free(g->block_bits);
+    free(g->empty_radius);
     memset(g, 0, sizeof *g);
 }
 
@@ -66,7 +64,7 @@ void field_grid_fill_occupancy(field_grid *g)
 {
     size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2];
     memset(g->cell_bits, 0xff, bit_words(cells) * sizeof(uint64_t));
-    memset(g->block_bits, 1, (size_t)g->blocks[0] * g->blocks[1] * g->blocks[2]);
+    memset(g->empty_radius, 0, cells);
     for (int a = 0; a < 3; a++) {
         g->occ_lo[a] = 0;
         g->occ_hi[a] = g->cells[a];
@@ -137,7 +135,6 @@ void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_wo
 {
     float d_min = field_density_threshold(f, f->occupancy_alpha, step_world);
     size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2];
-    size_t blocks = (size_t)g->blocks[0] * g->blocks[1] * g->blocks[2];
     uint8_t *point_on = malloc(g->points);
     if (!point_on) { /* cannot refine: keep everything occupied, which is always correct */
         field_grid_fill_occupancy(g);
@@ -148,7 +145,6 @@ void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_wo
         point_on[i] = g->values[i * FIELD_CH + FIELD_CH_DENSITY] >= d_min;
 
     memset(g->cell_bits, 0, bit_words(cells) * sizeof(uint64_t));
-    memset(g->block_bits, 0, blocks);
     size_t sy = (size_t)g->dim[0], sz = sy * (size_t)g->dim[1];
     int cx = g->cells[0], cy = g->cells[1], cz = g->cells[2];
     /* Each thread owns whole 64-bit words of cell bits (cells are numbered x fastest), so
@@ -165,6 +161,7 @@ void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_wo
         }
         g->cell_bits[w] = word;
     }
+    field_grid_update_empty_radius(g, point_on); /* points > cells: room to spare */
     free(point_on);
     for (int a = 0; a < 3; a++) {
         g->occ_lo[a] = g->cells[a];
@@ -180,10 +177,6 @@ void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_wo
                         g->occ_lo[a] = at[a] < g->occ_lo[a] ? at[a] : g->occ_lo[a];
                         g->occ_hi[a] = at[a] + 1 > g->occ_hi[a] ? at[a] + 1 : g->occ_hi[a];
                     }
-                    size_t b = (size_t)(x >> FIELD_BLOCK_SHIFT) +
-                               (size_t)g->blocks[0] * ((size_t)(y >> FIELD_BLOCK_SHIFT) +
-                                                       (size_t)g->blocks[1] * (z >> FIELD_BLOCK_SHIFT));
-                    g->block_bits[b] = 1;
                 }
             }
 }

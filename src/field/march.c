@@ -2,9 +2,8 @@
  *
  * Samples sit on a lattice t_k = t_start + (k + jitter) * step along the ray, so a ray gives
  * the same samples every time it is marched (the gradient check and determinism rely on
- * this). Empty 8^3-cell blocks are jumped over to the next lattice point behind them; empty
- * cells cost one bit test. */
-#include <float.h>
+ * this). Samples in empty cells are jumped over as far as the cell's empty-space radius
+ * allows (empty_space.c), to the next lattice point that may hold density. */
 #include <string.h>
 
 #include "field_internal.h"
@@ -60,19 +59,6 @@ typedef struct march_state {
     field_scratch *rec;
 } march_state;
 
-/* The ray parameter where the ray leaves block `b` (grid coordinates og + t * dg). */
-static float block_exit(const float og[3], const float dg[3], const float inv[3], const int b[3])
-{
-    float te = FLT_MAX;
-    for (int a = 0; a < 3; a++) {
-        if (dg[a] > 0)
-            te = fminf(te, ((float)((b[a] + 1) << FIELD_BLOCK_SHIFT) - og[a]) * inv[a]);
-        else if (dg[a] < 0)
-            te = fminf(te, ((float)(b[a] << FIELD_BLOCK_SHIFT) - og[a]) * inv[a]);
-    }
-    return te;
-}
-
 /* March grid `gi` over ray parameters [ta, tb). Returns 1 when the ray terminated. */
 static int march_segment(const vf_field *f, int gi, const field_ray *ray, float ta, float tb,
                          float jitter, float min_trans, const float basis[4], march_state *s)
@@ -80,15 +66,15 @@ static int march_segment(const vf_field *f, int gi, const field_ray *ray, float 
     const field_grid *g = &f->grids[gi];
     const float step = grid_step(f, g), inv_voxel = 1.0f / g->voxel;
     const float scale_step = f->density_scale * step, shift = f->density_shift;
-    float og[3], dg[3], inv[3];
+    float og[3], dg[3], fastest = 0;
     for (int a = 0; a < 3; a++) {
         og[a] = (ray->origin[a] - g->lo[a]) * inv_voxel;
         dg[a] = ray->dir[a] * inv_voxel;
-        inv[a] = dg[a] != 0 ? 1.0f / dg[a] : 0;
+        fastest = fabsf(dg[a]) > fastest ? fabsf(dg[a]) : fastest;
     }
+    const float samples_per_cell = 1.0f / (fastest * step);
     const size_t sy = (size_t)g->dim[0], sz = sy * (size_t)g->dim[1];
     const size_t cy = (size_t)g->cells[0], cz = cy * (size_t)g->cells[1];
-    const size_t by = (size_t)g->blocks[0], bz = by * (size_t)g->blocks[1];
     /* Offsets of the 8 corners of a cell, in floats. */
     const size_t o1 = FIELD_CH, oy = sy * FIELD_CH, oz = sz * FIELD_CH;
     const int recording = s->rec != NULL;
@@ -105,16 +91,12 @@ static int march_segment(const vf_field *f, int gi, const field_ray *ray, float 
             ci = ci < 0 ? 0 : ci >= g->cells[a] ? g->cells[a] - 1 : ci;
             c[a] = ci;
         }
-        int b[3] = {c[0] >> FIELD_BLOCK_SHIFT, c[1] >> FIELD_BLOCK_SHIFT, c[2] >> FIELD_BLOCK_SHIFT};
-        if (!g->block_bits[(size_t)b[0] + by * b[1] + bz * b[2]]) {
-            float te = block_exit(og, dg, inv, b);
-            int next = (int)ceilf((te - ta) / step - jitter);
-            k = next > k ? next : k + 1;
+        int radius = g->empty_radius[(size_t)c[0] + cy * c[1] + cz * c[2]];
+        if (radius) { /* empty: jump as far as empty space reaches */
+            k += field_empty_jump(radius, samples_per_cell);
             continue;
         }
         k++;
-        if (!field_cell_occupied(g, (size_t)c[0] + cy * c[1] + cz * c[2]))
-            continue;
 
         float fx = fminf(fmaxf(u[0] - (float)c[0], 0.0f), 1.0f);
         float fy = fminf(fmaxf(u[1] - (float)c[1], 0.0f), 1.0f);

@@ -178,8 +178,7 @@ void vf_field_get_info(const vf_field *f, vf_field_info *info)
         size_t cells = (size_t)gi->cells[0] * gi->cells[1] * gi->cells[2];
         info->points += gi->points;
         info->occupied_cells += field_grid_occupied_cells(gi);
-        info->bytes += gi->points * FIELD_CH * sizeof(float) + cells / 8 +
-                       (size_t)gi->blocks[0] * gi->blocks[1] * gi->blocks[2];
+        info->bytes += gi->points * FIELD_CH * sizeof(float) + cells / 8 + cells;
     }
 }
 

@@ -4,11 +4,11 @@
  * from the grid box entry), so renders agree with what training optimized, but:
  *   - the ray is clipped to the box of occupied cells and starts at the first lattice point
  *     inside it;
- *   - empty 8^3-cell blocks are jumped, empty cells cost one bit test;
+ *   - empty space is jumped: a sample in an empty cell moves the march as far as the cell's
+ *     empty-space radius allows (empty_space.c);
  *   - a sample's density is tested against a precomputed raw-density threshold before any
  *     transcendental function is evaluated, and samples under FIELD_VISIBLE_ALPHA are skipped;
  *   - exp/log are inlined polynomials (fast_math.h). */
-#include <float.h>
 
 #include "fast_math.h"
 #include "field_internal.h"
@@ -40,20 +40,6 @@ typedef struct render_state {
     int count;
 } render_state;
 
-/* The ray parameter where the ray leaves block b (grid coordinates og + t * dg). */
-static inline float block_exit(const float og[3], const float dg[3], const float inv[3],
-                               const int b[3])
-{
-    float te = FLT_MAX;
-    for (int a = 0; a < 3; a++) {
-        float face = dg[a] > 0 ? (float)((b[a] + 1) << FIELD_BLOCK_SHIFT)
-                               : (float)(b[a] << FIELD_BLOCK_SHIFT);
-        float ta = dg[a] != 0 ? (face - og[a]) * inv[a] : FLT_MAX;
-        te = ta < te ? ta : te;
-    }
-    return te;
-}
-
 static inline float clamp01(float x)
 {
     return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x;
@@ -80,16 +66,16 @@ static int render_segment(const vf_field *f, const field_render_grid *rg, int gi
     int k = (int)floorf((c0 - ta) / step - jitter);
     k = k < 0 ? 0 : k;
 
-    float og[3], dg[3], inv[3];
+    float og[3], dg[3], fastest = 0;
     for (int a = 0; a < 3; a++) {
         og[a] = (ray->origin[a] - g->lo[a]) * rg->inv_voxel;
         dg[a] = ray->dir[a] * rg->inv_voxel;
-        inv[a] = dg[a] != 0 ? 1.0f / dg[a] : 0;
+        fastest = fabsf(dg[a]) > fastest ? fabsf(dg[a]) : fastest;
     }
+    const float samples_per_cell = 1.0f / (fastest * step);
     const int ncx = g->cells[0], ncy = g->cells[1], ncz = g->cells[2];
     const size_t sy = (size_t)g->dim[0], sz = sy * (size_t)g->dim[1];
     const size_t cy = (size_t)ncx, cz = cy * (size_t)ncy;
-    const size_t by = (size_t)g->blocks[0], bz = by * (size_t)g->blocks[1];
     const size_t o1 = FIELD_CH, oy = sy * FIELD_CH, oz = sz * FIELD_CH;
 
     for (;;) {
@@ -101,17 +87,12 @@ static int render_segment(const vf_field *f, const field_render_grid *rg, int gi
         cx = cx < 0 ? 0 : cx >= ncx ? ncx - 1 : cx;
         cyi = cyi < 0 ? 0 : cyi >= ncy ? ncy - 1 : cyi;
         czi = czi < 0 ? 0 : czi >= ncz ? ncz - 1 : czi;
-        const int b[3] = {cx >> FIELD_BLOCK_SHIFT, cyi >> FIELD_BLOCK_SHIFT,
-                          czi >> FIELD_BLOCK_SHIFT};
-        if (!g->block_bits[(size_t)b[0] + by * b[1] + bz * b[2]]) {
-            float te = block_exit(og, dg, inv, b);
-            int next = (int)ceilf((te - ta) / step - jitter);
-            k = next > k ? next : k + 1;
+        const int radius = g->empty_radius[(size_t)cx + cy * cyi + cz * czi];
+        if (radius) {
+            k += field_empty_jump(radius, samples_per_cell);
             continue;
         }
         k++;
-        if (!field_cell_occupied(g, (size_t)cx + cy * cyi + cz * czi))
-            continue;
 
         const float fx = clamp01(ux - (float)cx), fy = clamp01(uy - (float)cyi);
         const float fz = clamp01(uz - (float)czi);
