@@ -205,11 +205,13 @@ static const vf_sfm_frame *frame_with_alpha(const poses_run *run, const char *na
 }
 
 /* Replace COLMAP's undistorted RGB of every frame that had alpha (a removed background) by
- * the frame undistorted with its alpha, so that training knows where the object ends. */
+ * the frame undistorted with its alpha (a white background keyed out), so that training knows
+ * where the object ends. */
 static vf_status restore_alpha(poses_run *run, const vf_colmap_model *undistorted,
                                const char *image_dir)
 {
     vf_status status = VF_OK;
+    int white_keyed = 0;
     vf_progress progress;
     vf_progress_begin(&progress, "undistorting alpha", (size_t)undistorted->image_count,
                       "images");
@@ -228,8 +230,12 @@ static vf_status restore_alpha(poses_run *run, const vf_colmap_model *undistorte
         status = vf_colmap_camera_to_vf(from, &lens);
         if (status == VF_OK)
             status = vf_colmap_camera_to_vf(to, &pinhole);
+        int keyed;
         if (status == VF_OK)
             status = vf_image_load(frame->source, &src);
+        if (status == VF_OK)
+            status = vf_sfm_key_white_background(&src, &keyed);
+        white_keyed += keyed;
         if (status == VF_OK)
             status = vf_sfm_undistort_frame(&src, &lens, &pinhole, &out);
         if (status == VF_OK)
@@ -241,6 +247,9 @@ static vf_status restore_alpha(poses_run *run, const vf_colmap_model *undistorte
         vf_progress_update(&progress, (size_t)i + 1, NULL);
     }
     vf_progress_end(&progress);
+    if (status == VF_OK && white_keyed > 0)
+        vf_info("%d frames had their background removed to white: it was made transparent "
+                "again, so that training sees the object's outline", white_keyed);
     return status;
 }
 

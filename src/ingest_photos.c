@@ -1,26 +1,34 @@
-/* Ingest from a folder of photos: score them all (in parallel), choose, write the chosen ones. */
+/* Ingest from a folder of photos: score them all (in parallel), choose, write the chosen ones.
+ * Photos with an alpha channel (background removed) keep it: they are written as PNG, so that
+ * training later knows where the object ends; the others are written as JPEG. */
 #define _GNU_SOURCE
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "ingest_internal.h"
+#include "vf/image.h"
 #include "vf/log.h"
 
 typedef struct photo_list {
-    char **names; /* file names in the folder, sorted */
+    char **names;          /* file names in the folder, sorted */
+    unsigned char *alpha;  /* per photo: 1 when it has an alpha channel */
     int count;
 } photo_list;
 
 static void photo_list_free(photo_list *list)
 {
     vf_free_names(list->names, list->count);
+    free(list->alpha);
     memset(list, 0, sizeof *list);
 }
 
 static vf_status list_photos(const char *folder, photo_list *list)
 {
     vf_status status = vf_list_images(folder, &list->names, &list->count);
+    if (status == VF_OK && list->count > 0 && !(list->alpha = calloc((size_t)list->count, 1)))
+        status = vf_fail(VF_EINTERNAL, "out of memory listing %s", folder);
     if (status == VF_OK && list->count == 0)
         status = vf_fail(VF_EINPUT,
                          "folder %s has no JPEG or PNG photos; give a folder of photos or a "
@@ -29,8 +37,9 @@ static vf_status list_photos(const char *folder, photo_list *list)
     return status;
 }
 
-/* Load and score every photo, in parallel; sizes gets width, height of each. */
-static vf_status score_photos(const char *folder, const photo_list *list, score_list *scores,
+/* Load and score every photo, in parallel; sizes gets width, height of each, list->alpha
+ * whether it has an alpha channel. */
+static vf_status score_photos(const char *folder, photo_list *list, score_list *scores,
                               int *sizes)
 {
     vf_status status = VF_OK;
@@ -42,7 +51,12 @@ static vf_status score_photos(const char *folder, const photo_list *list, score_
     for (int i = 0; i < list->count; i++) {
         char path[VF_PATH_MAX];
         vf_rgb8 photo = {0, 0, NULL};
+        int width, height, channels;
         vf_status s = vf_path_join(path, sizeof path, folder, list->names[i]);
+        if (s == VF_OK)
+            s = vf_image_info(path, &width, &height, &channels);
+        if (s == VF_OK)
+            list->alpha[i] = channels == 2 || channels == 4;
         if (s == VF_OK)
             s = vf_rgb8_load(path, &photo);
         if (s == VF_OK) {
@@ -69,7 +83,31 @@ static void output_name(const photo_list *list, int index, char *out, size_t siz
 {
     char stem[VF_PATH_MAX];
     vf_path_basename(stem, sizeof stem, list->names[index], 1);
-    snprintf(out, size, "%04d_%.200s.jpg", index, stem);
+    snprintf(out, size, "%04d_%.200s.%s", index, stem, list->alpha[index] ? "png" : "jpg");
+}
+
+/* Write a photo with its alpha channel as PNG, shrunk as ingest_save_frame shrinks. */
+static vf_status save_with_alpha(const char *path, const char *images_dir, const char *name,
+                                 int max_size, int *width, int *height)
+{
+    vf_image photo = {0}, small = {0};
+    char out[VF_PATH_MAX];
+    vf_status status = vf_image_load(path, &photo);
+    if (status == VF_OK)
+        status = vf_path_join(out, sizeof out, images_dir, name);
+    if (status == VF_OK) {
+        int longer = photo.width > photo.height ? photo.width : photo.height;
+        double scale = longer > max_size ? (double)max_size / longer : 1.0;
+        int w = (int)lround(photo.width * scale), h = (int)lround(photo.height * scale);
+        status = vf_image_resize(&photo, w > 0 ? w : 1, h > 0 ? h : 1, &small);
+    }
+    if (status == VF_OK)
+        status = vf_image_save(out, &small);
+    if (status == VF_OK && width)
+        *width = small.width, *height = small.height;
+    vf_image_free(&photo);
+    vf_image_free(&small);
+    return status;
 }
 
 /* Load, shrink and write the chosen photos, in parallel. */
@@ -85,9 +123,10 @@ static vf_status write_photos(const char *folder, const photo_list *list, const 
         vf_rgb8 photo = {0, 0, NULL};
         output_name(list, i, name, sizeof name);
         vf_status s = vf_path_join(path, sizeof path, folder, list->names[i]);
-        if (s == VF_OK)
-            s = vf_rgb8_load(path, &photo);
-        if (s == VF_OK)
+        if (s == VF_OK && list->alpha[i])
+            s = save_with_alpha(path, images_dir, name, max_size, k ? NULL : width,
+                                k ? NULL : height);
+        else if (s == VF_OK && (s = vf_rgb8_load(path, &photo)) == VF_OK)
             s = ingest_save_frame(images_dir, name, &photo, max_size, k ? NULL : width,
                                   k ? NULL : height);
         vf_rgb8_free(&photo);

@@ -44,6 +44,11 @@ vf_status vf_sfm_images_prepare(const char *src_dir, const char *dst_dir,
 
 void vf_sfm_images_free(vf_sfm_images *images);
 
+/* A frame with an alpha channel that is opaque everywhere but whose edge is mostly
+ * near-white (a background removed to white): make the near-white region connected to the
+ * edge transparent. *keyed says whether it did; other frames are left as they are. */
+vf_status vf_sfm_key_white_background(vf_image *img, int *keyed);
+
 /* Undistort a frame with all its channels (sfm_alpha.c): out gets the frame as the pinhole
  * camera `pinhole` sees it, sampled bilinearly from src, which camera `lens` (with distortion)
  * took; pixels that fall outside src are 0, so transparent. Uses every core. */

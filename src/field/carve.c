@@ -128,9 +128,13 @@ static void free_masks(const vf_field_trainer *t, uint8_t **masks)
     free(masks);
 }
 
-/* Whether some view sees world point p on a (dilated) transparent pixel. */
+/* Whether world point p is outside the visual hull: some view sees it on a (dilated)
+ * transparent pixel, or no masked view sees it at all (nothing was filmed there: a capture
+ * that covers only an arc would otherwise keep every corner of the box, and the field would
+ * fill them with fog). */
 static int carved(const vf_field_trainer *t, uint8_t *const *masks, const double p[3])
 {
+    int seen = 0;
     for (int i = 0; i < t->view_count; i++) {
         if (!masks[i])
             continue;
@@ -141,8 +145,9 @@ static int carved(const vf_field_trainer *t, uint8_t *const *masks, const double
             continue;
         if (!masks[i][(size_t)y * v->camera.width + (size_t)u])
             return 1;
+        seen = 1;
     }
-    return 0;
+    return !seen;
 }
 
 /* Carve a lattice of n^3 points over [lo, hi]; shrink [lo, hi] to the bounding box of what
