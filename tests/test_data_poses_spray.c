@@ -13,6 +13,7 @@
 
 #include "check.h"
 #include "poses_helpers.h"
+#include "vf/image.h"
 #include "vf/dataset.h"
 #include "vf/pose.h"
 
@@ -134,6 +135,33 @@ static void check_can_axis(const char *points_path)
     CHECK(tilt < 15, "the can stands upright in the object frame (%.1f deg off)", tilt);
 }
 
+/* The photos' backgrounds were removed to opaque white: the undistorted training frames must
+ * carry the object's mask again (transparent background, opaque can, nothing else). */
+static void check_masks(const char *transforms)
+{
+    vf_dataset ds;
+    CHECK(vf_dataset_load(transforms, &ds) == VF_OK, "undistorted poses: %s", vf_error_message());
+    double least = 1, most = 0;
+    for (int i = 0; i < ds.count; i++) {
+        vf_image img;
+        CHECK(vf_image_load(ds.frames[i].image_path, &img) == VF_OK, "%s", vf_error_message());
+        CHECK(img.channels == 4, "%s has alpha", ds.frames[i].image_path);
+        size_t n = (size_t)img.width * img.height, opaque = 0;
+        for (size_t k = 0; img.channels == 4 && k < n; k++)
+            opaque += img.data[4 * k + 3] > 0.5f;
+        double share = (double)opaque / (double)n;
+        least = share < least ? share : least;
+        most = share > most ? share : most;
+        CHECK(img.channels != 4 || img.data[3] == 0.0f, "the corner is transparent");
+        vf_image_free(&img);
+    }
+    printf("object masks: %d frames, the can covers %.1f%% to %.1f%% of each\n", ds.count,
+           100 * least, 100 * most);
+    CHECK(ds.count == 27 && least > 0.03 && most < 0.25, "masks cover the can only (%.3f..%.3f)",
+          least, most);
+    vf_dataset_free(&ds);
+}
+
 int main(int argc, char **argv)
 {
     char ws[VF_PATH_MAX], path[VF_PATH_MAX], out[VF_PATH_MAX], err[VF_PATH_MAX];
@@ -176,5 +204,7 @@ int main(int argc, char **argv)
     vf_dataset_free(&ds);
     vf_path_join(path, sizeof path, ws, "poses/points3D.txt");
     check_can_axis(path);
+    vf_path_join(path, sizeof path, ws, "poses/transforms_undistorted.json");
+    check_masks(path);
     return check_finish();
 }

@@ -87,6 +87,64 @@ static void test_mixed(const char *src, const char *dst)
     vf_sfm_images_free(&set);
 }
 
+/* A frame whose background was removed to opaque white: the white around a dark square is
+ * keyed out, the white hole inside the square is not (it does not touch the edge). */
+static void test_key_white(void)
+{
+    vf_image img;
+    CHECK(vf_image_alloc(&img, 40, 30, 4) == VF_OK, "alloc");
+    for (int y = 0; y < 30; y++)
+        for (int x = 0; x < 40; x++) {
+            float *p = img.data + ((size_t)y * 40 + x) * 4;
+            int square = x >= 10 && x < 30 && y >= 8 && y < 22, hole = x >= 18 && x < 22 &&
+                                                                      y >= 13 && y < 17;
+            p[0] = p[1] = p[2] = square && !hole ? 0.1f : 1.0f;
+            p[3] = 1.0f;
+        }
+    int keyed = 0;
+    CHECK(vf_sfm_key_white_background(&img, &keyed) == VF_OK && keyed, "white background keyed");
+    CHECK(img.data[3] == 0.0f && img.data[(29 * 40 + 39) * 4 + 3] == 0.0f, "corners transparent");
+    CHECK(img.data[(10 * 40 + 12) * 4 + 3] == 1.0f, "the object stays opaque");
+    CHECK(img.data[(15 * 40 + 20) * 4 + 3] == 1.0f, "a white hole inside the object stays opaque");
+    /* a real alpha channel is left alone */
+    img.data[(10 * 40 + 12) * 4 + 3] = 0.5f;
+    CHECK(vf_sfm_key_white_background(&img, &keyed) == VF_OK && !keyed, "real alpha kept");
+    vf_image_free(&img);
+}
+
+/* Undistorting with all channels: a lens without distortion gives the frame back exactly;
+ * a wider pinhole sees past the frame's edge, which comes out transparent; a distorted
+ * lens moves pixels where the camera model says. */
+static void test_undistort(void)
+{
+    vf_image src, out = {0};
+    CHECK(vf_image_alloc(&src, 32, 24, 4) == VF_OK, "alloc");
+    for (size_t i = 0; i < 32 * 24; i++) {
+        src.data[4 * i] = (float)(i % 32) / 32, src.data[4 * i + 1] = (float)(i / 32) / 24;
+        src.data[4 * i + 2] = 0.5f, src.data[4 * i + 3] = 1.0f;
+    }
+    vf_camera lens = {.width = 32, .height = 24, .fx = 30, .fy = 30, .cx = 16, .cy = 12};
+    CHECK(vf_sfm_undistort_frame(&src, &lens, &lens, &out) == VF_OK, "%s", vf_error_message());
+    CHECK(out.width == 32 && out.channels == 4 &&
+              !memcmp(out.data, src.data, 32 * 24 * 4 * sizeof(float)),
+          "no distortion: the same frame");
+    vf_image_free(&out);
+    vf_camera wide = lens;
+    wide.width = 40, wide.cx = 20;
+    CHECK(vf_sfm_undistort_frame(&src, &lens, &wide, &out) == VF_OK, "%s", vf_error_message());
+    CHECK(out.data[3] == 0.0f && out.data[(12 * 40 + 20) * 4 + 3] == 1.0f,
+          "outside the frame transparent, inside opaque");
+    vf_image_free(&out);
+    vf_camera barrel = lens;
+    barrel.k1 = -0.2;
+    CHECK(vf_sfm_undistort_frame(&src, &barrel, &lens, &out) == VF_OK, "%s", vf_error_message());
+    double p[3] = {(28.5 - 16) / 30, (20.5 - 12) / 30, 1}, u, v;
+    vf_camera_project(&barrel, p, &u, &v);
+    CHECK_NEAR(out.data[(20 * 32 + 28) * 4], (u - 0.5) / 32, 1e-5); /* red ramps with x */
+    vf_image_free(&src);
+    vf_image_free(&out);
+}
+
 int main(void)
 {
     static const float white[3] = {1, 1, 1};
@@ -99,6 +157,8 @@ int main(void)
     vf_mkdirs(src2);
     test_one_size(src, dst);
     test_mixed(src2, dst2);
+    test_key_white();
+    test_undistort();
 
     vf_sfm_images set;
     CHECK(vf_sfm_images_prepare(dst2 /* only subfolders */, dst, white, &set) == VF_EINPUT,

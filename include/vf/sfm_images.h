@@ -51,7 +51,8 @@ vf_status vf_sfm_key_white_background(vf_image *img, int *keyed);
 
 /* Undistort a frame with all its channels (sfm_alpha.c): out gets the frame as the pinhole
  * camera `pinhole` sees it, sampled bilinearly from src, which camera `lens` (with distortion)
- * took; pixels that fall outside src are 0, so transparent. Uses every core. */
+ * took; pixels that fall outside src are 0, so transparent. out is allocated here (pass a
+ * zeroed or freed image). Uses every core. */
 vf_status vf_sfm_undistort_frame(const vf_image *src, const vf_camera *lens,
                                  const vf_camera *pinhole, vf_image *out);
 
