@@ -5,7 +5,8 @@
  * into advice ("orbit 12 deg right, raise 5 cm"). Frames whose (smoothed and raw) viewpoint
  * lies within the tolerance box of the target are saved with their poses to
  * WS/reshoot_tNN/frames/ (PNG) and poses.json, ready for `vfcapture score`. Advice is printed as
- * plain lines (this build has no OpenCV highgui window). */
+ * plain lines and, where a display exists, drawn over the frames in a live window
+ * (vf/overlay.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +16,7 @@
 #include "physical.h"
 #include "vf/calib.h"
 #include "vf/log.h"
+#include "vf/overlay.h"
 #include "vf/targets.h"
 #include "vf/workspace.h"
 
@@ -24,8 +26,9 @@ static const char usage[] =
     "Guide a camera to exported target N (see 'vfcapture export'): every frame is localized\n"
     "against the capture's sparse model, the pose smoothed over time, and a line of advice\n"
     "printed (orbit, raise/lower, step back/closer, turn, tilt, roll; centimetres when the\n"
-    "workspace has a metric scale). Frames within the tolerance of the target are saved with\n"
-    "their poses in WS/reshoot_tNN/ (frames/*.png, poses.json), ready for 'vfcapture score'.\n"
+    "workspace has a metric scale), also over the frames in a live window where a display\n"
+    "exists. Frames within the tolerance of the target are saved with their poses in\n"
+    "WS/reshoot_tNN/ (frames/*.png, poses.json), ready for 'vfcapture score'.\n"
     "\n"
     "options:\n"
     "      --target N         exported target (0 is v*)\n"
@@ -34,7 +37,9 @@ static const char usage[] =
     "      --tolerance R      box half-width, percent of each parameter's range (default 5)\n"
     "      --smoothing A      weight of the newest pose, 0..1 (default 0.4; 1: no smoothing)\n"
     "      --seconds S        webcam: stop after S seconds (default 60)\n"
-    "      --every N          advise on every Nth frame (default 1)\n" PHYSICAL_LOCALIZE_HELP
+    "      --every N          advise on every Nth frame (default 1)\n"
+    "      --no-window        no live window, even where a display exists (q or Esc in the\n"
+    "                         window stops the capture)\n" PHYSICAL_LOCALIZE_HELP
         CLI_COMMON_HELP;
 
 enum {
@@ -44,12 +49,13 @@ enum {
     OPT_TOLERANCE,
     OPT_SMOOTHING,
     OPT_SECONDS,
-    OPT_EVERY
+    OPT_EVERY,
+    OPT_NO_WINDOW
 };
 
 typedef struct reshoot_options {
     const char *workspace, *device, *video;
-    int target, every;
+    int target, every, no_window;
     double tolerance, smoothing, seconds;
     vf_localize_options loc;
     cli_flags flags;
@@ -67,6 +73,8 @@ typedef struct reshoot_run {
     json_t *saved;           /* [{file, frame, viewpoint, c2w_object, ...}] */
     json_t *advice;          /* per frame, for --json */
     int seen, localized;
+    vf_overlay *window;      /* the live window, or NULL */
+    int quit;                /* the person closed it with q or Esc */
 } reshoot_run;
 
 static vf_status parse_value(int c, const char *arg, reshoot_options *o)
@@ -105,6 +113,9 @@ static vf_status parse_value(int c, const char *arg, reshoot_options *o)
             return vf_fail(VF_EINPUT, "--every: give a number from 1 to 1000");
         o->every = (int)n;
         return VF_OK;
+    case OPT_NO_WINDOW:
+        o->no_window = 1;
+        return VF_OK;
     }
     return VF_OK;
 }
@@ -120,6 +131,7 @@ static vf_status parse(int argc, char **argv, reshoot_options *o)
         {"smoothing", required_argument, NULL, OPT_SMOOTHING},
         {"seconds", required_argument, NULL, OPT_SECONDS},
         {"every", required_argument, NULL, OPT_EVERY},
+        {"no-window", no_argument, NULL, OPT_NO_WINDOW},
         {0, 0, 0, 0}};
     *o = (reshoot_options){.target = -1, .every = 1, .tolerance = 0.05, .smoothing = 0.4,
                            .seconds = 60};
@@ -213,7 +225,16 @@ static vf_status handle_frame(reshoot_run *run, const vf_rgb8 *frame, const fram
         printf("%s: %s\n", info->name, line);
         fflush(stdout);
     }
-    return VF_OK;
+    if (run->window) {
+        char head[96], counts[96];
+        snprintf(head, sizeof head, "target %d - %.60s", run->opt->target, info->name);
+        snprintf(counts, sizeof counts, "%d of %d frames localized, %d saved", run->localized,
+                 run->seen, (int)json_array_size(run->saved));
+        const char *lines[3] = {head, line, counts};
+        status = vf_overlay_show(run->window, frame, lines, 3,
+                                 strncmp(line, "ON TARGET", 9) == 0, &run->quit);
+    }
+    return status;
 }
 
 static vf_status capture(reshoot_run *run)
@@ -226,6 +247,9 @@ static vf_status capture(reshoot_run *run)
         return status;
     if (run->opt->device)
         vf_info("reading %s for %.0f s", run->opt->device, run->opt->seconds);
+    if (!run->opt->no_window && vf_overlay_available() &&
+        vf_overlay_open("vfcapture reshoot", &run->window) == VF_OK)
+        vf_info("showing the advice in a window (q or Esc stops)");
     vf_rgb8 frame = {0};
     frame_info info;
     int got;
@@ -235,9 +259,11 @@ static vf_status capture(reshoot_run *run)
             vf_error_prefix("%s", info.name);
             break;
         }
-        if (run->opt->device && vf_now() - start > run->opt->seconds)
+        if (run->quit || (run->opt->device && vf_now() - start > run->opt->seconds))
             break;
     }
+    vf_overlay_close(run->window);
+    run->window = NULL;
     vf_rgb8_free(&frame);
     frames_in_close(&in);
     return status;
