@@ -230,7 +230,7 @@ static vf_status restore_alpha(poses_run *run, const vf_colmap_model *undistorte
         status = vf_colmap_camera_to_vf(from, &lens);
         if (status == VF_OK)
             status = vf_colmap_camera_to_vf(to, &pinhole);
-        int keyed;
+        int keyed = 0;
         if (status == VF_OK)
             status = vf_image_load(frame->source, &src);
         if (status == VF_OK)

@@ -1,7 +1,7 @@
 /* Unit tests of the radiance-field engine on small synthetic fields: the inlined math, the
  * gradients of the ray marcher against finite differences, the fast renderer against the
- * training forward pass, deterministic rendering, model files (round trip, corrupt and
- * other-version files rejected) and checkpoint resume. */
+ * training forward pass, the empty-space radii, deterministic rendering, model files (round
+ * trip, corrupt and other-version files rejected) and checkpoint resume. */
 #include "check.h"
 
 #include <stdlib.h>
@@ -295,9 +295,46 @@ static void test_checkpoint_resume(void)
     vf_field_free(truth);
 }
 
+/* The empty-space radius of every cell is its Chebyshev distance to the nearest occupied
+ * cell (brute force over a 40 x 30 x 20 grid with two occupied cells), capped. */
+static void test_empty_radius(void)
+{
+    field_grid g;
+    const int dim[3] = {41, 31, 21}, occupied[2][3] = {{5, 7, 3}, {30, 20, 15}};
+    const float lo[3] = {0, 0, 0};
+    CHECK(field_grid_alloc(&g, dim, lo, 1.0f) == VF_OK, "alloc");
+    const int nx = g.cells[0], ny = g.cells[1], nz = g.cells[2];
+    size_t cells = (size_t)nx * ny * nz;
+    memset(g.cell_bits, 0, (cells + 63) / 64 * 8);
+    for (int k = 0; k < 2; k++) {
+        size_t c = (size_t)occupied[k][0] +
+                   (size_t)nx * (occupied[k][1] + (size_t)ny * occupied[k][2]);
+        g.cell_bits[c >> 6] |= 1ull << (c & 63);
+    }
+    uint8_t *scratch = malloc(cells);
+    field_grid_update_empty_radius(&g, scratch);
+    int wrong = 0;
+    for (int z = 0; z < nz; z++)
+        for (int y = 0; y < ny; y++)
+            for (int x = 0; x < nx; x++) {
+                int best = FIELD_MAX_RADIUS;
+                for (int k = 0; k < 2; k++) {
+                    int d = abs(x - occupied[k][0]);
+                    d = abs(y - occupied[k][1]) > d ? abs(y - occupied[k][1]) : d;
+                    d = abs(z - occupied[k][2]) > d ? abs(z - occupied[k][2]) : d;
+                    best = d < best ? d : best;
+                }
+                wrong += g.empty_radius[(size_t)x + (size_t)nx * (y + (size_t)ny * z)] != best;
+            }
+    CHECK(wrong == 0, "%d cells with a wrong empty-space radius", wrong);
+    free(scratch);
+    field_grid_free(&g);
+}
+
 int main(void)
 {
     test_fast_math();
+    test_empty_radius();
     test_gradients();
     test_render_matches_march();
     test_model_files();

@@ -96,9 +96,9 @@ void field_grid_fill_occupancy(field_grid *g);
 /* Recompute empty_radius from the occupancy bits; scratch holds one byte per cell. */
 void field_grid_update_empty_radius(field_grid *g, uint8_t *scratch);
 
-/* Samples a march may jump from a cell of empty-space radius r (> 0), for a ray moving
- * cells_per_sample cells per sample along its fastest axis: it lands r - 1 cells away at most,
- * so every sample jumped lies in an empty cell. */
+/* Samples a march may jump from a cell of empty-space radius r (> 0), for a ray that takes
+ * samples_per_cell samples per cell along its fastest axis: the samples jumped lie at most
+ * r - 1 cells away, so all in empty cells. */
 static inline int field_empty_jump(int radius, float samples_per_cell)
 {
     return 1 + (int)((float)(radius - 1) * samples_per_cell * 0.999f); /* 0.999: rounding */

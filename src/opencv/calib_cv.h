@@ -1,8 +1,9 @@
 /* src/opencv/calib_cv.h: OpenCV's camera calibration, for calib/ (internal to the library).
  *
  * Board corners lie on z = 0 at object_xy (2 per corner); uv[v] holds view v's 2 * corners
- * pixel positions (vf/camera.h convention), NaN for corners the view did not see. Poses are 6 doubles per view: rotation vector and
- * translation, board -> camera in OpenCV axes (x_cam = R x_board + t). */
+ * pixel positions (vf/camera.h convention), NaN for corners the view did not see. Poses are
+ * 6 doubles per view: rotation vector and translation, board -> camera in OpenCV axes
+ * (x_cam = R x_board + t). */
 #ifndef VF_CALIB_CV_H
 #define VF_CALIB_CV_H
 
