@@ -128,22 +128,20 @@ static void free_masks(const vf_field_trainer *t, uint8_t **masks)
     free(masks);
 }
 
-/* Whether world point p is outside the visual hull: some view sees it on a (dilated)
- * transparent pixel, or no masked view sees it at all (nothing was filmed there: a capture
- * that covers only an arc would otherwise keep every corner of the box, and the field would
- * fill them with fog). */
+/* Whether world point p is outside the visual hull: some masked view sees it on a (dilated)
+ * transparent pixel, or no view sees it at all (nothing was filmed there: a capture that
+ * covers only an arc would otherwise keep every corner of the box, and the field would fill
+ * them with fog). */
 static int carved(const vf_field_trainer *t, uint8_t *const *masks, const double p[3])
 {
     int seen = 0;
     for (int i = 0; i < t->view_count; i++) {
-        if (!masks[i])
-            continue;
         const train_view *v = &t->views[i];
         double u, y, depth;
         if (!project(v, p, &u, &y, &depth) || u < 0 || y < 0 || u >= v->camera.width ||
             y >= v->camera.height)
             continue;
-        if (!masks[i][(size_t)y * v->camera.width + (size_t)u])
+        if (masks[i] && !masks[i][(size_t)y * v->camera.width + (size_t)u])
             return 1;
         seen = 1;
     }
