@@ -53,18 +53,37 @@ static vf_field *make_field(void)
 
 static void test_fast_math(void)
 {
-    double worst_exp = 0, worst_sp = 0, worst_sig = 0;
-    /* float x * log2(e) rounds: the error grows with |x| (2e-6 at 20, where alpha saturates) */
+    double worst_exp = 0, worst_sig = 0;
+    /* float x * log2(e) rounds: the error grows with |x| */
     for (float x = -20; x < 20; x += 0.0137f) {
-        double e = exp((double)x);
-        worst_exp = fmax(worst_exp, fabs(fast_exp(x) - e) / e);
-        double sp = log1p(exp((double)x));
-        worst_sp = fmax(worst_sp, fabs(fast_softplus(x) - sp) / sp);
-        worst_sig = fmax(worst_sig, fabs(fast_sigmoid(x) - 1 / (1 + exp(-(double)x))));
+        fast_f4 e = fast_exp2_4((fast_f4){x, -x, 0.5f * x, 0} * 1.44269504f);
+        worst_exp = fmax(worst_exp, fabs(e[0] - exp((double)x)) / exp((double)x));
+        worst_exp = fmax(worst_exp, fabs(e[1] - exp(-(double)x)) / exp(-(double)x));
+        fast_f4 s = fast_sigmoid4((fast_f4){x, -x, 0, 0});
+        worst_sig = fmax(worst_sig, fabs(s[0] - 1 / (1 + exp(-(double)x))));
+        worst_sig = fmax(worst_sig, fabs(s[1] - 1 / (1 + exp((double)x))));
     }
-    CHECK(worst_exp < 2e-6, "fast_exp relative error %g", worst_exp);
-    CHECK(worst_sp < 2e-6, "fast_softplus relative error %g", worst_sp);
-    CHECK(worst_sig < 1e-6, "fast_sigmoid error %g", worst_sig);
+    CHECK(worst_exp < 2e-6, "fast_exp2_4 relative error %g", worst_exp);
+    CHECK(worst_sig < 1e-6, "fast_sigmoid4 error %g", worst_sig);
+}
+
+/* The renderer's opacity table against 1 - exp(-softplus(d + shift) * scale * step). */
+static void test_alpha_table(void)
+{
+    vf_field *f = make_field();
+    field_render_setup setup;
+    field_render_setup_init(f, &setup);
+    const field_render_grid *r = &setup.grids[0];
+    double worst = 0;
+    for (float d = r->visible_density; d < r->visible_density + 60; d += 0.00731f) {
+        double x = (double)d + f->density_shift;
+        double exact = -expm1(-log1p(exp(x)) * r->scale_step);
+        worst = fmax(worst, fabs(field_render_alpha(r, d) - exact));
+    }
+    CHECK(fabs(field_render_alpha(r, r->visible_density) - FIELD_VISIBLE_ALPHA) < 1e-6,
+          "alpha at the visibility threshold %g", field_render_alpha(r, r->visible_density));
+    CHECK(worst < 1e-5, "alpha table error %g", worst);
+    vf_field_free(f);
 }
 
 /* loss = g . rgb(ray) for a fixed g; its gradient by field_backward and by central differences. */
@@ -334,6 +353,7 @@ static void test_empty_radius(void)
 int main(void)
 {
     test_fast_math();
+    test_alpha_table();
     test_empty_radius();
     test_gradients();
     test_render_matches_march();

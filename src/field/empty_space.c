@@ -3,8 +3,8 @@
  *
  * The distance is Chebyshev (the largest per-axis difference of cell indices), which is what
  * a jump needs: when a sample's cell has radius r, every cell whose indices differ from its
- * own by at most r - 1 on each axis is empty, so the ray may move r - 1 cells along its
- * fastest axis without meeting density. The transform is separable: per row along x, then
+ * own by at most r - 1 on each axis is empty, so the ray may skip every sample before it
+ * leaves that box of cells (field_empty_skip). The transform is separable: per row along x, then
  * min over y of max(|dy|, row distance), then the same over z. */
 #include <string.h>
 

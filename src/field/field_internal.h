@@ -96,12 +96,37 @@ void field_grid_fill_occupancy(field_grid *g);
 /* Recompute empty_radius from the occupancy bits; scratch holds one byte per cell. */
 void field_grid_update_empty_radius(field_grid *g, uint8_t *scratch);
 
-/* Samples a march may jump from a cell of empty-space radius r (> 0), for a ray that takes
- * samples_per_cell samples per cell along its fastest axis: the samples jumped lie at most
- * r - 1 cells away, so all in empty cells. */
-static inline int field_empty_jump(int radius, float samples_per_cell)
+/* Jumping over empty space. A sample in a cell c of empty-space radius r > 0 may be followed
+ * by every later sample that lies before the ray leaves the box of cells within Chebyshev
+ * distance r - 1 of c: they are all empty. Per ray, in grid units (cells): */
+typedef struct field_skip {
+    float inv_dir[3]; /* 1 / direction per axis (1e30 for a zero component) */
+    int forward[3];   /* direction component >= 0 */
+    float inv_step;   /* samples per unit of ray parameter */
+} field_skip;
+
+static inline void field_skip_init(field_skip *skip, const float dir_cells[3], float step)
 {
-    return 1 + (int)((float)(radius - 1) * samples_per_cell * 0.999f); /* 0.999: rounding */
+    for (int a = 0; a < 3; a++) {
+        skip->forward[a] = dir_cells[a] >= 0;
+        skip->inv_dir[a] = dir_cells[a] != 0 ? 1.0f / dir_cells[a] : 1e30f;
+    }
+    skip->inv_step = 1.0f / step;
+}
+
+/* Samples to advance from a sample at grid position u in cell c of radius r > 0 (at least 1:
+ * the sample itself). The 0.999 keeps a sample that rounding puts on the box's far face out
+ * of the jump. */
+static inline int field_empty_skip(const field_skip *skip, const float u[3], const int c[3],
+                                   int radius)
+{
+    float exit = 3e38f;
+    for (int a = 0; a < 3; a++) {
+        float face = (float)(skip->forward[a] ? c[a] + radius : c[a] + 1 - radius);
+        float t = (face - u[a]) * skip->inv_dir[a];
+        exit = t < exit ? t : exit;
+    }
+    return exit > 0 ? 1 + (int)(exit * skip->inv_step * 0.999f) : 1;
 }
 
 /* The raw density d at which a step of step_world reaches opacity `alpha`: alpha >= threshold
@@ -176,10 +201,15 @@ int field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], fl
 
 /* ---- render_march.c: one ray, forward only, as fast as it goes -------------------------- */
 
+/* Opacity of a step as a function of raw density, tabulated (see field_render_setup_init). */
+#define FIELD_ALPHA_TABLE 2048
+
 /* Per-grid constants of a render, computed once per image. */
 typedef struct field_render_grid {
     float step, scale_step, inv_voxel;
     float visible_density; /* raw density below which a sample's alpha is negligible */
+    float alpha_per_density; /* table entries per unit of raw density */
+    float alpha[FIELD_ALPHA_TABLE + 1]; /* alpha at visible_density + i / alpha_per_density */
     float occ_lo[3], occ_hi[3]; /* world box of the occupied cells */
     int empty;                  /* no occupied cell */
 } field_render_grid;
@@ -189,6 +219,16 @@ typedef struct field_render_setup {
 } field_render_setup;
 
 void field_render_setup_init(const vf_field *f, field_render_setup *setup);
+
+/* The opacity of a sample of raw density d >= visible_density, from the grid's table. */
+static inline float field_render_alpha(const field_render_grid *r, float d)
+{
+    const float u = (d - r->visible_density) * r->alpha_per_density;
+    if (u >= (float)FIELD_ALPHA_TABLE)
+        return r->alpha[FIELD_ALPHA_TABLE];
+    const int i = (int)u;
+    return r->alpha[i] + (u - (float)i) * (r->alpha[i + 1] - r->alpha[i]);
+}
 
 /* The forward march of field_march without recording (same lattice of samples), for
  * rendering: samples of negligible opacity (under 1e-3) are skipped, rays are
@@ -203,6 +243,22 @@ void field_render_ray(const vf_field *f, const field_render_setup *setup, const 
  * pixel in OpenCV axes (x right, y down) or NULL for a pinhole computed from the camera. */
 void field_camera_ray(const vf_camera *cam, const double c2w[16], double x, double y,
                       field_ray *ray);
+
+/* Plain comparisons: fminf/fmaxf keep NaN semantics and are library calls unless -ffast-math. */
+static inline float field_min(float a, float b)
+{
+    return a < b ? a : b;
+}
+
+static inline float field_max(float a, float b)
+{
+    return a > b ? a : b;
+}
+
+static inline float field_clamp01(float x)
+{
+    return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x;
+}
 
 static inline float field_softplus(float x)
 {

@@ -25,8 +25,8 @@ int field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], fl
             ta = tb;
             tb = swap;
         }
-        enter = fmaxf(enter, ta);
-        leave = fminf(leave, tb);
+        enter = field_max(enter, ta);
+        leave = field_min(leave, tb);
     }
     *t0 = enter;
     *t1 = leave;
@@ -66,13 +66,13 @@ static int march_segment(const vf_field *f, int gi, const field_ray *ray, float 
     const field_grid *g = &f->grids[gi];
     const float step = grid_step(f, g), inv_voxel = 1.0f / g->voxel;
     const float scale_step = f->density_scale * step, shift = f->density_shift;
-    float og[3], dg[3], fastest = 0;
+    float og[3], dg[3];
     for (int a = 0; a < 3; a++) {
         og[a] = (ray->origin[a] - g->lo[a]) * inv_voxel;
         dg[a] = ray->dir[a] * inv_voxel;
-        fastest = fabsf(dg[a]) > fastest ? fabsf(dg[a]) : fastest;
     }
-    const float samples_per_cell = 1.0f / (fastest * step);
+    field_skip skip;
+    field_skip_init(&skip, dg, step);
     const size_t sy = (size_t)g->dim[0], sz = sy * (size_t)g->dim[1];
     const size_t cy = (size_t)g->cells[0], cz = cy * (size_t)g->cells[1];
     /* Offsets of the 8 corners of a cell, in floats. */
@@ -93,14 +93,14 @@ static int march_segment(const vf_field *f, int gi, const field_ray *ray, float 
         }
         int radius = g->empty_radius[(size_t)c[0] + cy * c[1] + cz * c[2]];
         if (radius) { /* empty: jump as far as empty space reaches */
-            k += field_empty_jump(radius, samples_per_cell);
+            k += field_empty_skip(&skip, u, c, radius);
             continue;
         }
         k++;
 
-        float fx = fminf(fmaxf(u[0] - (float)c[0], 0.0f), 1.0f);
-        float fy = fminf(fmaxf(u[1] - (float)c[1], 0.0f), 1.0f);
-        float fz = fminf(fmaxf(u[2] - (float)c[2], 0.0f), 1.0f);
+        float fx = field_clamp01(u[0] - (float)c[0]);
+        float fy = field_clamp01(u[1] - (float)c[1]);
+        float fz = field_clamp01(u[2] - (float)c[2]);
         size_t base = (size_t)c[0] + sy * c[1] + sz * c[2];
         const float *v = g->values + base * FIELD_CH;
         float w0 = (1 - fx) * (1 - fy) * (1 - fz), w1 = fx * (1 - fy) * (1 - fz);

@@ -6,13 +6,32 @@
  *     inside it;
  *   - empty space is jumped: a sample in an empty cell moves the march as far as the cell's
  *     empty-space radius allows (empty_space.c);
- *   - a sample's density is tested against a precomputed raw-density threshold before any
- *     transcendental function is evaluated, and samples under FIELD_VISIBLE_ALPHA are skipped;
- *   - exp/log are inlined polynomials (fast_math.h). */
+ *   - a sample's density is tested against a precomputed raw-density threshold first, and
+ *     samples under FIELD_VISIBLE_ALPHA are skipped;
+ *   - opacity comes from a table of raw density, and the colour's three sigmoids are one
+ *     four-lane vector operation (fast_math.h);
+ *   - trilinear sums are added as trees, not as one long chain of dependent additions. */
+
+#include <string.h>
 
 #include "fast_math.h"
 #include "field_internal.h"
 
+/* alpha(d) = 1 - exp(-softplus(d + shift) * scale * step) on [visible_density, d_opaque],
+ * where d_opaque makes alpha 1 in float: a table lookup with linear interpolation replaces an
+ * exp, a log and an exp per sample (test_field bounds the table's error). */
+static void tabulate_alpha(const vf_field *f, field_render_grid *r)
+{
+    const double opaque_sigma = 17.0 / r->scale_step; /* exp(-17) < 2^-24 */
+    const double d_opaque = (opaque_sigma > 20 ? opaque_sigma : log(expm1(opaque_sigma))) -
+                            f->density_shift;
+    r->alpha_per_density = (float)(FIELD_ALPHA_TABLE / (d_opaque - r->visible_density));
+    for (int i = 0; i <= FIELD_ALPHA_TABLE; i++) {
+        double x = r->visible_density + i / (double)r->alpha_per_density + f->density_shift;
+        double softplus = x > 30 ? x : log1p(exp(x));
+        r->alpha[i] = (float)-expm1(-softplus * r->scale_step);
+    }
+}
 
 void field_render_setup_init(const vf_field *f, field_render_setup *setup)
 {
@@ -24,6 +43,7 @@ void field_render_setup_init(const vf_field *f, field_render_setup *setup)
         r->scale_step = f->density_scale * r->step;
         r->inv_voxel = 1.0f / g->voxel;
         r->visible_density = field_density_threshold(f, FIELD_VISIBLE_ALPHA, r->step);
+        tabulate_alpha(f, r);
         r->empty = 0;
         for (int a = 0; a < 3; a++) {
             r->empty |= g->occ_lo[a] >= g->occ_hi[a];
@@ -35,20 +55,41 @@ void field_render_setup_init(const vf_field *f, field_render_setup *setup)
 
 typedef struct render_state {
     float trans;
-    float rgb[3];
+    fast_f4 rgb; /* lanes 0..2 */
     float depth;
     int count;
 } render_state;
 
-static inline float clamp01(float x)
+static inline fast_f4 load4(const float *p)
 {
-    return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x;
+    fast_f4 v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+/* The colour of a sample: trilinear SH logits from the 8 corners (offsets and weights), their
+ * dot products with the view basis, sigmoid; four lanes at a time, lane 3 unused. */
+static inline fast_f4 sample_colour(const float *v, const size_t offset[8], const float w[8],
+                                    fast_f4 basis)
+{
+    fast_f4 sh[3];
+    for (int c = 0; c < 3; c++) {
+        const float *p = v + FIELD_CH_SH + 4 * c;
+        sh[c] = ((w[0] * load4(p + offset[0]) + w[1] * load4(p + offset[1])) +
+                 (w[2] * load4(p + offset[2]) + w[3] * load4(p + offset[3]))) +
+                ((w[4] * load4(p + offset[4]) + w[5] * load4(p + offset[5])) +
+                 (w[6] * load4(p + offset[6]) + w[7] * load4(p + offset[7])));
+    }
+    fast_f4 p0 = sh[0] * basis, p1 = sh[1] * basis, p2 = sh[2] * basis;
+    fast_f4 logits = {p0[0] + p0[1] + p0[2] + p0[3], p1[0] + p1[1] + p1[2] + p1[3],
+                      p2[0] + p2[1] + p2[2] + p2[3], 0.0f};
+    return fast_sigmoid4(logits);
 }
 
 /* March grid gi over [ta, tb), the lattice anchored at ta. Returns 1 when the ray ended. */
 static int render_segment(const vf_field *f, const field_render_grid *rg, int gi,
                           const field_ray *ray, float ta, float tb, float jitter, float min_trans,
-                          const float basis[4], render_state *s)
+                          fast_f4 basis, render_state *s)
 {
     if (rg->empty)
         return 0;
@@ -59,20 +100,20 @@ static int render_segment(const vf_field *f, const field_render_grid *rg, int gi
     float c0, c1;
     if (!field_ray_box(&clipped, rg->occ_lo, rg->occ_hi, &c0, &c1))
         return 0;
-    const float step = rg->step, scale_step = rg->scale_step, shift = f->density_shift;
+    const float step = rg->step;
     const float visible = rg->visible_density;
     /* one lattice point either side of the clipped range: their cells are tested anyway */
-    const float end = fminf(tb, c1 + step);
+    const float end = field_min(tb, c1 + step);
     int k = (int)floorf((c0 - ta) / step - jitter);
     k = k < 0 ? 0 : k;
 
-    float og[3], dg[3], fastest = 0;
+    float og[3], dg[3];
     for (int a = 0; a < 3; a++) {
         og[a] = (ray->origin[a] - g->lo[a]) * rg->inv_voxel;
         dg[a] = ray->dir[a] * rg->inv_voxel;
-        fastest = fabsf(dg[a]) > fastest ? fabsf(dg[a]) : fastest;
     }
-    const float samples_per_cell = 1.0f / (fastest * step);
+    field_skip skip;
+    field_skip_init(&skip, dg, step);
     const int ncx = g->cells[0], ncy = g->cells[1], ncz = g->cells[2];
     const size_t sy = (size_t)g->dim[0], sz = sy * (size_t)g->dim[1];
     const size_t cy = (size_t)ncx, cz = cy * (size_t)ncy;
@@ -89,36 +130,31 @@ static int render_segment(const vf_field *f, const field_render_grid *rg, int gi
         czi = czi < 0 ? 0 : czi >= ncz ? ncz - 1 : czi;
         const int radius = g->empty_radius[(size_t)cx + cy * cyi + cz * czi];
         if (radius) {
-            k += field_empty_jump(radius, samples_per_cell);
+            k += field_empty_skip(&skip, (const float[3]){ux, uy, uz}, (const int[3]){cx, cyi, czi}, radius);
             continue;
         }
         k++;
 
-        const float fx = clamp01(ux - (float)cx), fy = clamp01(uy - (float)cyi);
-        const float fz = clamp01(uz - (float)czi);
+        const float fx = field_clamp01(ux - (float)cx), fy = field_clamp01(uy - (float)cyi);
+        const float fz = field_clamp01(uz - (float)czi);
         const size_t base = (size_t)cx + sy * cyi + sz * czi;
         const float *v = g->values + base * FIELD_CH;
-        const float w0 = (1 - fx) * (1 - fy) * (1 - fz), w1 = fx * (1 - fy) * (1 - fz);
-        const float w2 = (1 - fx) * fy * (1 - fz), w3 = fx * fy * (1 - fz);
-        const float w4 = (1 - fx) * (1 - fy) * fz, w5 = fx * (1 - fy) * fz;
-        const float w6 = (1 - fx) * fy * fz, w7 = fx * fy * fz;
-        const float d = w0 * v[0] + w1 * v[o1] + w2 * v[oy] + w3 * v[oy + o1] + w4 * v[oz] +
-                        w5 * v[oz + o1] + w6 * v[oz + oy] + w7 * v[oz + oy + o1];
+        const float gx = 1 - fx, gy = 1 - fy, gz = 1 - fz;
+        const float a00 = gx * gy, a10 = fx * gy, a01 = gx * fy, a11 = fx * fy;
+        const float w[8] = {a00 * gz, a10 * gz, a01 * gz, a11 * gz,
+                            a00 * fz, a10 * fz, a01 * fz, a11 * fz};
+        const size_t corner[8] = {0, o1, oy, oy + o1, oz, oz + o1, oz + oy, oz + oy + o1};
+        /* summed as a tree: a chain of eight dependent FMAs was the march's longest latency */
+        const float d = ((w[0] * v[corner[0]] + w[1] * v[corner[1]]) +
+                         (w[2] * v[corner[2]] + w[3] * v[corner[3]])) +
+                        ((w[4] * v[corner[4]] + w[5] * v[corner[5]]) +
+                         (w[6] * v[corner[6]] + w[7] * v[corner[7]]));
         if (d < visible)
             continue;
-        const float alpha = 1.0f - fast_exp(-fast_softplus(d + shift) * scale_step);
+        const float alpha = field_render_alpha(rg, d);
 
-        float acc[FIELD_CH];
-        for (int ch = 0; ch < FIELD_CH; ch++)
-            acc[ch] = w0 * v[ch] + w1 * v[o1 + ch] + w2 * v[oy + ch] + w3 * v[oy + o1 + ch] +
-                      w4 * v[oz + ch] + w5 * v[oz + o1 + ch] + w6 * v[oz + oy + ch] +
-                      w7 * v[oz + oy + o1 + ch];
         const float weight = s->trans * alpha;
-        for (int c = 0; c < 3; c++) {
-            const float *sh = acc + FIELD_CH_SH + 4 * c;
-            s->rgb[c] += weight * fast_sigmoid(sh[0] * basis[0] + sh[1] * basis[1] +
-                                               sh[2] * basis[2] + sh[3] * basis[3]);
-        }
+        s->rgb += weight * sample_colour(v, corner, w, basis);
         s->depth += weight * t;
         s->count++;
         s->trans *= 1.0f - alpha;
@@ -131,7 +167,7 @@ void field_render_ray(const vf_field *f, const field_render_setup *setup, const 
                       float jitter, float min_trans, field_march_result *out)
 {
     render_state s = {.trans = 1.0f};
-    const float basis[4] = {1.0f, ray->dir[0], ray->dir[1], ray->dir[2]};
+    const fast_f4 basis = {1.0f, ray->dir[0], ray->dir[1], ray->dir[2]};
     const field_grid *inner = &f->grids[0];
     const field_render_grid *rg = setup->grids;
     float i0, i1;
