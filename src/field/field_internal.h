@@ -35,10 +35,10 @@
 #define FIELD_MAX_RADIUS 32 /* empty-space radii are counted up to this many cells */
 #define FIELD_MAX_GRIDS 2
 #define FIELD_EMPTY_DENSITY (-30.0f) /* raw density of carved-away space */
-/* Rendering skips samples below this opacity: together they carry about 0.5% of a ray's
- * weight on chair, and skipping them left test PSNR unchanged (+0.02 dB) while cutting a
- * third of the samples. */
-#define FIELD_VISIBLE_ALPHA 1e-3f
+/* Rendering skips samples below this opacity. Against a threshold of 1e-3: chair test PSNR
+ * 34.15 -> 34.11 dB, fox held-out photos unchanged (21.36 dB), a 224x224 render about a fifth
+ * faster. */
+#define FIELD_VISIBLE_ALPHA 3e-3f
 
 typedef struct field_grid {
     int dim[3];        /* grid points along x, y, z */
@@ -231,7 +231,7 @@ static inline float field_render_alpha(const field_render_grid *r, float d)
 }
 
 /* The forward march of field_march without recording (same lattice of samples), for
- * rendering: samples of negligible opacity (under 1e-3) are skipped, rays are
+ * rendering: samples under FIELD_VISIBLE_ALPHA are skipped, rays are
  * clipped to the occupied cells, and the transcendental functions are inlined. */
 void field_render_ray(const vf_field *f, const field_render_setup *setup, const field_ray *ray,
                       float jitter, float min_trans, field_march_result *out);
