@@ -231,8 +231,8 @@ static inline float field_render_alpha(const field_render_grid *r, float d)
 }
 
 /* The forward march of field_march without recording (same lattice of samples), for
- * rendering: samples under FIELD_VISIBLE_ALPHA are skipped, rays are
- * clipped to the occupied cells, and the transcendental functions are inlined. */
+ * rendering: samples under FIELD_VISIBLE_ALPHA are skipped, rays are clipped to the occupied
+ * cells, opacity comes from the setup's table (see render_march.c). */
 void field_render_ray(const vf_field *f, const field_render_setup *setup, const field_ray *ray,
                       float jitter, float min_trans, field_march_result *out);
 
