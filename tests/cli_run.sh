@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The pipeline end to end on a small budget: `run` on the chair (import, train, attack,
 # export), a second `run` that finds every stage up to date, `render` and `eval` of the
-# trained field, a benchmark set built and scored by two models, and bad input to those
+# trained field, a benchmark set built and scored by every shared model, and bad input to those
 # commands failing with one line while the workspace stays as it was.
 source "$(dirname "$0")/shell_checks.sh"
 
@@ -29,9 +29,10 @@ json_check "eval: 10 views, mean PSNR above 21 dB (white: 14.4)" 'd["views"] == 
 
 expect 0 "benchmark build" -- "$tool" benchmark build "$ws" -o "$tmp/set" --count 4 --quiet
 [ "$(ls "$tmp/set/images" | wc -l)" -eq 8 ] && ok || bad "4 natural + 4 adversarial images"
-expect 0 "benchmark eval" -- "$tool" benchmark eval "$tmp/set" --models mobilenet_v2_1.0_224_quant,mobilenet_v1_0.5_160_quant --json --quiet
-json_check "two models, natural and adversarial rows of 4 images" \
-  'len(d["results"]) == 8 and all(r["total"] == 4 for r in d["results"])'
+expect 0 "benchmark eval, every shared model" -- "$tool" benchmark eval "$tmp/set" --models all --json --quiet
+models=$(ls "$shared/models"/*.onnx | wc -l)
+json_check "$models models (all of ../shared/models), natural and adversarial rows of 4 images" \
+  "len(d['results']) == 4 * $models and all(r['total'] == 4 for r in d['results']) and len({r['model'] for r in d['results']}) == $models"
 [ -s "$tmp/set/accuracy.png" ] && [ -s "$tmp/set/results.md" ] && ok || bad "benchmark reports written"
 
 # Bad input: one line, exit 1, the workspace as it was.
