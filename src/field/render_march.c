@@ -130,7 +130,8 @@ static int render_segment(const vf_field *f, const field_render_grid *rg, int gi
         czi = czi < 0 ? 0 : czi >= ncz ? ncz - 1 : czi;
         const int radius = g->empty_radius[(size_t)cx + cy * cyi + cz * czi];
         if (radius) {
-            k += field_empty_skip(&skip, (const float[3]){ux, uy, uz}, (const int[3]){cx, cyi, czi}, radius);
+            k += field_empty_skip(&skip, (const float[3]){ux, uy, uz},
+                                  (const int[3]){cx, cyi, czi}, radius);
             continue;
         }
         k++;
