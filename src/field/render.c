@@ -48,20 +48,20 @@ static vf_status check_camera(const vf_camera *cam)
 }
 
 /* Render one image into rgb (3 floats a pixel), depth and opacity (1 float a pixel; may be
- * NULL). Runs in the calling thread; `parallel` spreads rows over the cores. */
-static void render_rows(const vf_field *f, const vf_camera *cam, const double c2w[16], float *rgb,
-                        float *depth, float *opacity, int parallel)
+ * NULL), with the field's render setup (made once for a batch of images). Runs in the calling
+ * thread; `parallel` spreads rows over the cores. */
+static void render_rows(const vf_field *f, const field_render_setup *setup, const vf_camera *cam,
+                        const double c2w[16], float *rgb, float *depth, float *opacity,
+                        int parallel)
 {
     const int width = cam->width, height = cam->height;
-    field_render_setup setup;
-    field_render_setup_init(f, &setup);
 #pragma omp parallel for schedule(dynamic, 2) if (parallel)
     for (int y = 0; y < height; y++) {
         for (int x = 0; x < width; x++) {
             field_ray ray;
             field_march_result res;
             field_camera_ray(cam, c2w, x + 0.5, y + 0.5, &ray);
-            field_render_ray(f, &setup, &ray, 0.5f, f->stop_transmittance, &res);
+            field_render_ray(f, setup, &ray, 0.5f, f->stop_transmittance, &res);
             size_t i = (size_t)y * width + x;
             if (rgb)
                 memcpy(rgb + 3 * i, res.rgb, sizeof res.rgb);
@@ -74,6 +74,15 @@ static void render_rows(const vf_field *f, const vf_camera *cam, const double c2
     }
 }
 
+/* One image, its rows spread over the cores. */
+static void render_one(const vf_field *f, const vf_camera *cam, const double c2w[16], float *rgb,
+                       float *depth, float *opacity)
+{
+    field_render_setup setup;
+    field_render_setup_init(f, &setup);
+    render_rows(f, &setup, cam, c2w, rgb, depth, opacity, 1);
+}
+
 vf_status vf_field_render(const vf_field *f, const vf_camera *cam, const double c2w[16],
                           vf_image *out)
 {
@@ -81,7 +90,7 @@ vf_status vf_field_render(const vf_field *f, const vf_camera *cam, const double 
     if (status == VF_OK)
         status = ensure_image(out, cam->width, cam->height, 3);
     if (status == VF_OK)
-        render_rows(f, cam, c2w, out->data, NULL, NULL, 1);
+        render_one(f, cam, c2w, out->data, NULL, NULL);
     return status;
 }
 
@@ -93,15 +102,17 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
         status = ensure_image(&out[i], cam->width, cam->height, 3);
     if (status != VF_OK)
         return status;
+    field_render_setup setup;
+    field_render_setup_init(f, &setup);
     /* Small images: one image per thread keeps each core on its own memory; otherwise split
      * every image's rows. */
     if ((size_t)cam->width * cam->height <= 512 * 512 && n > 1) {
 #pragma omp parallel for schedule(dynamic, 1)
         for (int i = 0; i < n; i++)
-            render_rows(f, cam, c2w + 16 * i, out[i].data, NULL, NULL, 0);
+            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, NULL, NULL, 0);
     } else {
         for (int i = 0; i < n; i++)
-            render_rows(f, cam, c2w + 16 * i, out[i].data, NULL, NULL, 1);
+            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, NULL, NULL, 1);
     }
     return VF_OK;
 }
@@ -130,8 +141,7 @@ vf_status vf_field_render_depth(const vf_field *f, const vf_camera *cam, const d
     if (status == VF_OK && opacity)
         status = ensure_image(opacity, cam->width, cam->height, 1);
     if (status == VF_OK)
-        render_rows(f, cam, c2w, NULL, depth ? depth->data : NULL, opacity ? opacity->data : NULL,
-                    1);
+        render_one(f, cam, c2w, NULL, depth ? depth->data : NULL, opacity ? opacity->data : NULL);
     return status;
 }
 
