@@ -159,6 +159,7 @@ static void apply_setting(vf_field_train_options *o, const char *text)
     else if (!strcmp(name, "lr_color")) o->lr_color = (float)v;
     else if (!strcmp(name, "tv_density")) o->tv_density = (float)v;
     else if (!strcmp(name, "tv_color")) o->tv_color = (float)v;
+    else if (!strcmp(name, "prune_alpha")) o->prune_alpha = (float)v;
     else if (!strcmp(name, "box_scale")) o->box_scale = (float)v;
     else if (!strcmp(name, "background_scale")) o->background_scale = (float)v;
     else if (!strcmp(name, "keep_background")) o->keep_background = (int)v;
@@ -174,6 +175,7 @@ static double progress_every = 5;
 
 typedef struct run_result {
     double psnr, ssim, train_seconds, peak_mib;
+    double eval_ms; /* rendering and scoring one held-out view */
     int steps;
 } run_result;
 
@@ -213,7 +215,7 @@ static vf_field *train(const vf_field_train_options *opt, const view_set *views,
 
 static void evaluate(const vf_field *f, const view_set *test, const float bg[3], run_result *r)
 {
-    double psnr = 0, ssim = 0;
+    double psnr = 0, ssim = 0, t0 = vf_now();
     for (int i = 0; i < test->count; i++) {
         vf_image render = {0}, truth = {0};
         if (vf_field_render(f, &test->cameras[i], test->c2w + 16 * i, &render) != VF_OK)
@@ -226,12 +228,13 @@ static void evaluate(const vf_field *f, const view_set *test, const float bg[3],
     }
     r->psnr = psnr / test->count;
     r->ssim = ssim / test->count;
+    r->eval_ms = (vf_now() - t0) * 1000 / test->count;
 }
 
 static void print_run(const char *scene, double minutes, const run_result *r, double target)
 {
-    printf("%-6s %4.1f min  %5d steps  PSNR %6.2f dB  SSIM %.4f  peak %6.0f MiB  %s\n", scene,
-           minutes, r->steps, r->psnr, r->ssim, r->peak_mib,
+    printf("%-6s %4.1f min  %5d steps  PSNR %6.2f dB  SSIM %.4f  peak %6.0f MiB  %.0f ms/view  %s\n",
+           scene, minutes, r->steps, r->psnr, r->ssim, r->peak_mib, r->eval_ms,
            target > 0 ? (r->psnr >= target ? "(target met)" : "(BELOW TARGET)") : "");
     fflush(stdout);
 }

@@ -249,7 +249,7 @@ vf_status trainer_build_grid(vf_field_trainer *t)
     f->camera_distance = distance;
     memcpy(f->background, t->opt.background, sizeof f->background);
     f->step_ratio = 0.5f;
-    f->occupancy_alpha = 1e-4f;
+    f->occupancy_alpha = (float)TRAIN_OCCUPANCY_ALPHA;
     /* renders end a ray once 99% of it is covered: chair test PSNR unchanged (34.11 -> 34.12
      * dB against 1e-3), a 224x224 render about a tenth faster */
     f->stop_transmittance = 1e-2f;
@@ -272,10 +272,10 @@ vf_status trainer_build_grid(vf_field_trainer *t)
     f->grid_count = 1;
 
     /* density: sigma = softplus(d + shift) / final_voxel, shifted so that d = 0 gives a faint
-     * alpha_init per step at the coarsest level (DVGO's initialization) */
-    const double alpha_init = 0.01;
+     * TRAIN_ALPHA_INIT per step at the coarsest level */
     f->density_scale = 1.0f / t->final_voxel;
-    double softplus_shift = -log(1.0 - alpha_init) / (f->density_scale * f->step_ratio * voxel0);
+    double softplus_shift =
+        -log(1.0 - TRAIN_ALPHA_INIT) / (f->density_scale * f->step_ratio * voxel0);
     f->density_shift = (float)log(expm1(softplus_shift));
 
     if (t->has_alpha && (status = carve_grid(t, &f->grids[0], near_depth)) != VF_OK)

@@ -27,6 +27,7 @@ void vf_field_train_defaults(vf_field_train_options *opt)
     opt->lr_color = 0.05f;
     opt->tv_density = 0;
     opt->tv_color = 0;
+    opt->prune_alpha = 0.1f;
     opt->seed = 1;
     opt->threads = 0;
 }
@@ -41,6 +42,8 @@ static vf_status check_options(const vf_field_train_options *o)
         return vf_fail(VF_EINPUT, "grid of %g points is out of range", o->max_points);
     if (o->levels < 1 || o->levels > 8)
         return vf_fail(VF_EINPUT, "levels must be 1..8");
+    if (!(o->prune_alpha >= 0 && o->prune_alpha < 1))
+        return vf_fail(VF_EINPUT, "prune_alpha must be in [0, 1)");
     return VF_OK;
 }
 
@@ -170,6 +173,25 @@ static int level_at(const vf_field_trainer *t, double fraction)
     return level > last ? last : level;
 }
 
+/* The occupancy threshold (opacity per step) at a budget fraction. Cells where no corner
+ * reaches it are skipped by training and rendering; they get no gradient, so they stay
+ * pruned. It starts at TRAIN_OCCUPANCY_ALPHA and, once the finest level is reached, rises
+ * geometrically to prune_alpha at PRUNE_END of the budget. Without the rise, photos of a real
+ * scene train into haze: faint density in every cell standing in for surfaces (the fox grid
+ * kept 100% of its cells, ~280 samples a training ray); pruning the faint cells makes the
+ * survivors become the surfaces. At 3 minutes, fox held-out PSNR 21.21 -> 22.05 dB with 54
+ * samples a ray, chair test 34.28 -> 34.79 dB, lego 31.93 -> 32.65 dB; renders 2-4x faster.
+ * Ending at 0.07 or 0.15 instead of 0.1: fox 22.05 and 21.08 dB. */
+#define PRUNE_END 0.7
+static float occupancy_alpha_at(const vf_field_trainer *t, double fraction)
+{
+    const double start = TRAIN_OCCUPANCY_ALPHA, end = t->opt.prune_alpha;
+    if (!(end > start) || fraction <= t->opt.upsample_end)
+        return (float)start;
+    double x = (fraction - t->opt.upsample_end) / (PRUNE_END - t->opt.upsample_end);
+    return (float)(start * pow(end / start, x < 1 ? x : 1));
+}
+
 /* Go one level finer: resample every grid at 2^(1/3) times smaller spacing. */
 static vf_status upsample(vf_field_trainer *t)
 {
@@ -284,9 +306,11 @@ vf_status vf_field_trainer_step(vf_field_trainer *t, vf_field_train_status *stat
     if (st != VF_OK)
         return st;
     vf_field *f = t->field;
-    if (t->step % OCCUPANCY_EVERY == 0 && t->step > 0)
+    if (t->step % OCCUPANCY_EVERY == 0 && t->step > 0) {
+        f->occupancy_alpha = occupancy_alpha_at(t, fraction);
         for (int i = 0; i < f->grid_count; i++)
             field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
+    }
 
     const int n = t->opt.batch_rays;
     uint32_t *pixels = malloc((size_t)n * sizeof *pixels);
