@@ -60,36 +60,41 @@ typedef struct render_state {
     int count;
 } render_state;
 
-static inline fast_f4 load4(const float *p)
+/* One grid point: density, the 12 SH logits and padding, a 64-byte cache line. */
+typedef float point_f16 __attribute__((vector_size(FIELD_CH * sizeof(float))));
+
+static inline point_f16 load_point(const float *p)
 {
-    fast_f4 v;
+    point_f16 v;
     memcpy(&v, p, sizeof v);
     return v;
 }
 
-/* The colour of a sample: trilinear SH logits from the 8 corners (offsets and weights), their
- * dot products with the view basis, sigmoid; four lanes at a time, lane 3 unused. */
-static inline fast_f4 sample_colour(const float *v, const size_t offset[8], const float w[8],
-                                    fast_f4 basis)
+/* Every channel of a sample at once: the trilinear blend of its cell's 8 corner points
+ * (offsets and weights), summed as a tree (a chain of eight dependent FMAs was the march's
+ * longest latency). */
+static inline point_f16 trilinear(const float *v, const size_t offset[8], const float w[8])
 {
-    fast_f4 sh[3];
-    for (int c = 0; c < 3; c++) {
-        const float *p = v + FIELD_CH_SH + 4 * c;
-        sh[c] = ((w[0] * load4(p + offset[0]) + w[1] * load4(p + offset[1])) +
-                 (w[2] * load4(p + offset[2]) + w[3] * load4(p + offset[3]))) +
-                ((w[4] * load4(p + offset[4]) + w[5] * load4(p + offset[5])) +
-                 (w[6] * load4(p + offset[6]) + w[7] * load4(p + offset[7])));
-    }
-    fast_f4 p0 = sh[0] * basis, p1 = sh[1] * basis, p2 = sh[2] * basis;
-    fast_f4 logits = {p0[0] + p0[1] + p0[2] + p0[3], p1[0] + p1[1] + p1[2] + p1[3],
-                      p2[0] + p2[1] + p2[2] + p2[3], 0.0f};
+    return ((w[0] * load_point(v + offset[0]) + w[1] * load_point(v + offset[1])) +
+            (w[2] * load_point(v + offset[2]) + w[3] * load_point(v + offset[3]))) +
+           ((w[4] * load_point(v + offset[4]) + w[5] * load_point(v + offset[5])) +
+            (w[6] * load_point(v + offset[6]) + w[7] * load_point(v + offset[7])));
+}
+
+/* The colour of a sample from its blended point: each colour's SH logits dotted with the
+ * view basis (`basis` holds (1, x, y, z) at every colour's lanes), sigmoid; lane 3 unused. */
+static inline fast_f4 sample_colour(point_f16 point, point_f16 basis)
+{
+    const point_f16 p = point * basis;
+    const fast_f4 logits = {p[1] + p[2] + p[3] + p[4], p[5] + p[6] + p[7] + p[8],
+                            p[9] + p[10] + p[11] + p[12], 0.0f};
     return fast_sigmoid4(logits);
 }
 
 /* March grid gi over [ta, tb), the lattice anchored at ta. Returns 1 when the ray ended. */
 static int render_segment(const vf_field *f, const field_render_grid *rg, int gi,
                           const field_ray *ray, float ta, float tb, float jitter, float min_trans,
-                          fast_f4 basis, render_state *s)
+                          point_f16 basis, render_state *s)
 {
     if (rg->empty)
         return 0;
@@ -145,17 +150,15 @@ static int render_segment(const vf_field *f, const field_render_grid *rg, int gi
         const float w[8] = {a00 * gz, a10 * gz, a01 * gz, a11 * gz,
                             a00 * fz, a10 * fz, a01 * fz, a11 * fz};
         const size_t corner[8] = {0, o1, oy, oy + o1, oz, oz + o1, oz + oy, oz + oy + o1};
-        /* summed as a tree: a chain of eight dependent FMAs was the march's longest latency */
-        const float d = ((w[0] * v[corner[0]] + w[1] * v[corner[1]]) +
-                         (w[2] * v[corner[2]] + w[3] * v[corner[3]])) +
-                        ((w[4] * v[corner[4]] + w[5] * v[corner[5]]) +
-                         (w[6] * v[corner[6]] + w[7] * v[corner[7]]));
+        /* all channels at once: a corner's 16 floats are one vector load */
+        const point_f16 point = trilinear(v, corner, w);
+        const float d = point[FIELD_CH_DENSITY];
         if (d < visible)
             continue;
         const float alpha = field_render_alpha(rg, d);
 
         const float weight = s->trans * alpha;
-        s->rgb += weight * sample_colour(v, corner, w, basis);
+        s->rgb += weight * sample_colour(point, basis);
         s->depth += weight * t;
         s->count++;
         s->trans *= 1.0f - alpha;
@@ -168,7 +171,8 @@ void field_render_ray(const vf_field *f, const field_render_setup *setup, const 
                       float jitter, float min_trans, field_march_result *out)
 {
     render_state s = {.trans = 1.0f};
-    const fast_f4 basis = {1.0f, ray->dir[0], ray->dir[1], ray->dir[2]};
+    const float x = ray->dir[0], y = ray->dir[1], z = ray->dir[2];
+    const point_f16 basis = {0, 1, x, y, z, 1, x, y, z, 1, x, y, z, 0, 0, 0};
     const field_grid *inner = &f->grids[0];
     const field_render_grid *rg = setup->grids;
     float i0, i1;
