@@ -6,11 +6,11 @@
  *     inside it;
  *   - empty space is jumped: a sample in an empty cell moves the march as far as the cell's
  *     empty-space radius allows (empty_space.c);
- *   - a sample's density is tested against a precomputed raw-density threshold first, and
- *     samples under FIELD_VISIBLE_ALPHA are skipped;
+ *   - a sample blends all 16 floats of its 8 corner points as 16-lane vectors (one cache line
+ *     each), added as a tree, not as one long chain of dependent additions;
+ *   - samples under FIELD_VISIBLE_ALPHA are skipped by a raw-density threshold;
  *   - opacity comes from a table of raw density, and the colour's three sigmoids are one
- *     four-lane vector operation (fast_math.h);
- *   - trilinear sums are added as trees, not as one long chain of dependent additions. */
+ *     four-lane vector operation (fast_math.h). */
 
 #include <string.h>
 
@@ -86,9 +86,12 @@ static inline point_f16 trilinear(const float *v, const size_t offset[8], const 
 static inline fast_f4 sample_colour(point_f16 point, point_f16 basis)
 {
     const point_f16 p = point * basis;
-    const fast_f4 logits = {p[1] + p[2] + p[3] + p[4], p[5] + p[6] + p[7] + p[8],
-                            p[9] + p[10] + p[11] + p[12], 0.0f};
-    return fast_sigmoid4(logits);
+    /* lane k of each: colour k's term of basis function b; lane 3 gets padding times 0 */
+    const fast_f4 b0 = __builtin_shufflevector(p, p, 1, 5, 9, 13);
+    const fast_f4 b1 = __builtin_shufflevector(p, p, 2, 6, 10, 14);
+    const fast_f4 b2 = __builtin_shufflevector(p, p, 3, 7, 11, 15);
+    const fast_f4 b3 = __builtin_shufflevector(p, p, 4, 8, 12, 0);
+    return fast_sigmoid4((b0 + b1) + (b2 + b3));
 }
 
 /* March grid gi over [ta, tb), the lattice anchored at ta. Returns 1 when the ray ended. */
