@@ -183,12 +183,16 @@ static int level_at(const vf_field_trainer *t, double fraction)
  * samples a ray, chair test 34.28 -> 34.79 dB, lego 31.93 -> 32.65 dB; renders 2-4x faster.
  * Ending at 0.07 or 0.15 instead of 0.1: fox 22.05 and 21.08 dB. */
 #define PRUNE_END 0.7
+#define PRUNE_MIN_STEPS 1200 /* a short budget ramps no faster than over this many steps */
 static float occupancy_alpha_at(const vf_field_trainer *t, double fraction)
 {
     const double start = TRAIN_OCCUPANCY_ALPHA, end = t->opt.prune_alpha;
     if (!(end > start) || fraction <= t->opt.upsample_end)
         return (float)start;
     double x = (fraction - t->opt.upsample_end) / (PRUNE_END - t->opt.upsample_end);
+    /* a field pruned before its surfaces formed loses them: the fox trained for one minute
+     * (875 steps) kept 0.5% of its cells and reached 16.5 dB */
+    x = fmin(x, (double)t->step / PRUNE_MIN_STEPS);
     return (float)(start * pow(end / start, x < 1 ? x : 1));
 }
 
