@@ -129,8 +129,9 @@ typedef struct vf_field_train_options {
                                 times tan(half the narrower field of view) (0: automatic) */
     float lr_density, lr_color; /* Adam learning rates (decay 10x over the run) */
     float tv_density, tv_color; /* total-variation weights (0: off) */
-    float prune_alpha;       /* by 70% of the budget, cells where no corner reaches this
-                                opacity per step are pruned (0: no pruning ramp; train.c) */
+    float prune_alpha;       /* by 70% of the budget (and 1200 steps at the earliest), cells
+                                where no corner reaches this opacity per step are pruned (0: no
+                                pruning ramp; see train.c) */
     uint64_t seed;
     int threads;             /* 0: all cores */
 } vf_field_train_options;

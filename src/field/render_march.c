@@ -86,7 +86,7 @@ static inline point_f16 trilinear(const float *v, const size_t offset[8], const 
 static inline fast_f4 sample_colour(point_f16 point, point_f16 basis)
 {
     const point_f16 p = point * basis;
-    /* lane k of each: colour k's term of basis function b; lane 3 gets padding times 0 */
+    /* lane k of each: colour k's term of basis function b; lane 3 is 0 (basis lanes 0, 13..15) */
     const fast_f4 b0 = __builtin_shufflevector(p, p, 1, 5, 9, 13);
     const fast_f4 b1 = __builtin_shufflevector(p, p, 2, 6, 10, 14);
     const fast_f4 b2 = __builtin_shufflevector(p, p, 3, 7, 11, 15);
