@@ -1,6 +1,6 @@
 /* Unit tests of the radiance-field engine on small synthetic fields: the inlined math, the
  * gradients of the ray marcher against finite differences, the fast renderer against the
- * training forward pass, the empty-space radii, deterministic rendering, model files (round
+ * training forward pass, the empty-space radii and jumps, deterministic rendering, model files (round
  * trip, corrupt and other-version files rejected) and checkpoint resume. */
 #include "check.h"
 
@@ -45,7 +45,8 @@ static vf_field *make_field(void)
     f->background[0] = f->background[1] = f->background[2] = 1.0f;
     f->occupancy_alpha = 1e-4f;
     f->stop_transmittance = 1e-3f;
-    f->camera = (vf_camera){.width = 32, .height = 32, .fx = 40, .fy = 40, .cx = 16, .cy = 16};
+    /* 30 wide: rows are marched four rays at a time and two alone (render_march.c) */
+    f->camera = (vf_camera){.width = 30, .height = 32, .fx = 40, .fy = 40, .cx = 15, .cy = 16};
     f->camera_distance = 4;
     field_grid_update_occupancy(g, f, f->step_ratio * voxel);
     return f;
@@ -193,6 +194,115 @@ static void test_render_matches_march(void)
         vf_image_free(&batch[i]);
     vf_image_free(&img);
     vf_image_free(&again);
+    vf_field_free(f);
+}
+
+/* A 48^3 field over [-1, 1]^3 that is empty but for two small opaque balls: long jumps. */
+static vf_field *make_sparse_field(void)
+{
+    vf_field *f = make_field();
+    field_grid *g = &f->grids[0];
+    field_grid_free(g);
+    const int dim[3] = {48, 48, 48};
+    const float lo[3] = {-1, -1, -1}, voxel = 2.0f / 47;
+    if (field_grid_alloc(g, dim, lo, voxel) != VF_OK)
+        abort();
+    const float centres[2][3] = {{-0.4f, 0.1f, 0.2f}, {0.5f, -0.3f, -0.1f}};
+    for (size_t i = 0; i < g->points; i++) {
+        float *v = g->values + i * FIELD_CH;
+        const float p[3] = {lo[0] + voxel * (float)(i % 48), lo[1] + voxel * (float)(i / 48 % 48),
+                            lo[2] + voxel * (float)(i / (48 * 48))};
+        v[FIELD_CH_DENSITY] = FIELD_EMPTY_DENSITY;
+        for (int b = 0; b < 2; b++) {
+            float r2 = 0;
+            for (int a = 0; a < 3; a++)
+                r2 += (p[a] - centres[b][a]) * (p[a] - centres[b][a]);
+            if (r2 < 0.25f * 0.25f)
+                v[FIELD_CH_DENSITY] = uniform(0.0f, 4.0f);
+        }
+        for (int ch = FIELD_CH_SH; ch < FIELD_CH_USED; ch++)
+            v[ch] = uniform(-1, 1);
+    }
+    f->density_scale = 1.0f / voxel;
+    field_grid_update_occupancy(g, f, f->step_ratio * voxel);
+    return f;
+}
+
+/* The samples in occupied cells that the training march records (min_trans 0: rays go through
+ * both balls) for every pixel of a view: cell and position of each. Returns the floats written. */
+static int record_march(const vf_field *f, const double c2w[16], field_scratch *sc, float *out,
+                        int room)
+{
+    int n = 0;
+    const field_grid *g = &f->grids[0];
+    for (int y = 0; y < f->camera.height; y++)
+        for (int x = 0; x < f->camera.width; x++) {
+            field_ray ray;
+            field_march_result res;
+            field_camera_ray(&f->camera, c2w, x + 0.5, y + 0.5, &ray);
+            field_march(f, &ray, 0.5f, 0.0f, sc, &res);
+            for (int i = 0; i < res.count && n + 4 <= room; i++) {
+                const uint32_t p = sc->samples[i].base;
+                const size_t px = p % g->dim[0], py = p / g->dim[0] % g->dim[1];
+                const size_t pz = p / g->dim[0] / g->dim[1];
+                if (!field_cell_occupied(g, px + g->cells[0] * (py + g->cells[1] * pz)))
+                    continue;
+                out[n] = (float)p;
+                memcpy(out + n + 1, sc->samples[i].frac, 3 * sizeof(float));
+                n += 4;
+            }
+        }
+    return n;
+}
+
+/* Jumps over empty space skip only empty cells: with the real empty-space radii both marchers
+ * take exactly the samples they take when they test every sample (all radii 0; the empty
+ * cells hold FIELD_EMPTY_DENSITY, invisible to both). */
+static void test_jumps_skip_only_empty(void)
+{
+    vf_field *f = make_sparse_field();
+    field_grid *g = &f->grids[0];
+    const size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2];
+    int longest = 0;
+    for (size_t c = 0; c < cells; c++)
+        longest = g->empty_radius[c] > longest ? g->empty_radius[c] : longest;
+    CHECK(longest >= 10, "the sparse field has long jumps (largest radius %d)", longest);
+
+    const vf_viewpoint views[3] = {{.psi = 30, .theta = 10, .phi = 60},
+                                   {.psi = -70, .theta = -35, .phi = 200, .dx = 0.3},
+                                   {.psi = 5, .theta = 60, .phi = 130, .dz = -0.5}};
+    field_scratch sc = {.capacity = field_max_samples(f)};
+    sc.samples = malloc((size_t)sc.capacity * sizeof *sc.samples);
+    const int room = 1 << 20;
+    float *recorded[2] = {malloc(room * sizeof(float)), malloc(room * sizeof(float))};
+    vf_image img[2] = {{0}}; /* [0] with jumps, [1] testing every sample */
+    for (int i = 0; i < 3; i++) {
+        double c2w[16];
+        vf_viewpoint_to_c2w(&views[i], c2w);
+        const uint8_t *radius = g->empty_radius;
+        uint8_t *saved = malloc(cells);
+        memcpy(saved, radius, cells);
+        int n[2];
+        for (int pass = 0; pass < 2; pass++) {
+            if (pass)
+                memset(g->empty_radius, 0, cells);
+            CHECK(vf_field_render(f, &f->camera, c2w, &img[pass]) == VF_OK, "render: %s",
+                  vf_error_message());
+            n[pass] = record_march(f, c2w, &sc, recorded[pass], room);
+        }
+        memcpy(g->empty_radius, saved, cells);
+        free(saved);
+        CHECK(n[0] > 400 && n[0] < room, "view %d: the march records %d values", i, n[0]);
+        CHECK(n[0] == n[1] && memcmp(recorded[0], recorded[1], n[0] * sizeof(float)) == 0,
+              "view %d: jumps change the training march's samples", i);
+        CHECK(max_diff(&img[0], &img[1]) == 0, "view %d: jumps change the render by %g", i,
+              max_diff(&img[0], &img[1]));
+    }
+    for (int pass = 0; pass < 2; pass++) {
+        vf_image_free(&img[pass]);
+        free(recorded[pass]);
+    }
+    free(sc.samples);
     vf_field_free(f);
 }
 
@@ -359,6 +469,7 @@ int main(void)
     test_empty_radius();
     test_gradients();
     test_render_matches_march();
+    test_jumps_skip_only_empty();
     test_model_files();
     test_checkpoint_resume();
     return check_finish();

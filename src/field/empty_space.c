@@ -4,8 +4,8 @@
  * The distance is Chebyshev (the largest per-axis difference of cell indices), which is what
  * a jump needs: when a sample's cell has radius r, every cell whose indices differ from its
  * own by at most r - 1 on each axis is empty, so the ray may skip every sample before it
- * leaves that box of cells (field_empty_skip). The transform is separable: per row along x, then
- * min over y of max(|dy|, row distance), then the same over z. */
+ * leaves that box of cells (field_lattice_skip). The transform is separable: per row along x,
+ * then min over y of max(|dy|, row distance), then the same over z. */
 #include <string.h>
 
 #include "field_internal.h"

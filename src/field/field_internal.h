@@ -96,37 +96,55 @@ void field_grid_fill_occupancy(field_grid *g);
 /* Recompute empty_radius from the occupancy bits; scratch holds one byte per cell. */
 void field_grid_update_empty_radius(field_grid *g, uint8_t *scratch);
 
-/* Jumping over empty space. A sample in a cell c of empty-space radius r > 0 may be followed
- * by every later sample that lies before the ray leaves the box of cells within Chebyshev
- * distance r - 1 of c: they are all empty. Per ray, in grid units (cells): */
-typedef struct field_skip {
-    float inv_dir[3]; /* 1 / direction per axis (1e30 for a zero component) */
-    int forward[3];   /* direction component >= 0 */
-    float inv_step;   /* samples per unit of ray parameter */
-} field_skip;
-
-static inline void field_skip_init(field_skip *skip, const float dir_cells[3], float step)
+/* Plain comparisons: fminf/fmaxf keep NaN semantics and are library calls unless -ffast-math. */
+static inline float field_min(float a, float b)
 {
-    for (int a = 0; a < 3; a++) {
-        skip->forward[a] = dir_cells[a] >= 0;
-        skip->inv_dir[a] = dir_cells[a] != 0 ? 1.0f / dir_cells[a] : 1e30f;
-    }
-    skip->inv_step = 1.0f / step;
+    return a < b ? a : b;
 }
 
-/* Samples to advance from a sample at grid position u in cell c of radius r > 0 (at least 1:
- * the sample itself). The 0.999 keeps a sample that rounding puts on the box's far face out
- * of the jump. */
-static inline int field_empty_skip(const field_skip *skip, const float u[3], const int c[3],
-                                   int radius)
+static inline float field_max(float a, float b)
 {
-    float exit = 3e38f;
+    return a > b ? a : b;
+}
+
+/* A ray's samples in one grid, in cell units: sample k (a whole number kept as a float) sits
+ * at u0 + k * du, ray parameter t0 + k * step. */
+typedef struct field_lattice {
+    float u0[3], du[3];
+    float samples_per_cell[3]; /* 0.999 / |du| per axis (1e30 when du is 0): a hair short, so
+                                  that rounding cannot put a jump on its box's far face */
+} field_lattice;
+
+static inline void field_lattice_init(field_lattice *l, const field_grid *g, const float origin[3],
+                                      const float dir[3], float t0, float step)
+{
+    const float inv_voxel = 1.0f / g->voxel;
     for (int a = 0; a < 3; a++) {
-        float face = (float)(skip->forward[a] ? c[a] + radius : c[a] + 1 - radius);
-        float t = (face - u[a]) * skip->inv_dir[a];
-        exit = t < exit ? t : exit;
+        l->u0[a] = (origin[a] + t0 * dir[a] - g->lo[a]) * inv_voxel;
+        l->du[a] = dir[a] * step * inv_voxel;
+        l->samples_per_cell[a] = l->du[a] != 0 ? 0.999f / fabsf(l->du[a]) : 1e30f;
     }
-    return exit > 0 ? 1 + (int)(exit * skip->inv_step * 0.999f) : 1;
+}
+
+/* Jumping over empty space: sample k at grid position u lies in cell c of empty-space radius
+ * r > 0, so every cell within Chebyshev distance r - 1 of c is empty (empty_space.c). Returns
+ * the first sample past that box of cells (at least k + 1).
+ * Per axis the ray has (r + e) cells to go, e in [-1, 0] being minus the distance from u back to
+ * the face of its cell behind it (-1 at most: a position outside the grid is clamped into the
+ * edge cell). Everything but r is known before r is loaded, so the jump adds only an FMA, a
+ * min and a floor to the march's chain of dependent loads, the renderer's bottleneck. Each
+ * FMA is >= 0 exactly (|e * n| <= n <= r * n), so the result is never below k + 1. */
+static inline float field_lattice_skip(const field_lattice *l, float k, const float u[3],
+                                       const int c[3], int radius)
+{
+    float exit[3];
+    const float r = (float)radius;
+    for (int a = 0; a < 3; a++) {
+        const float n = l->samples_per_cell[a];
+        const float e = l->du[a] >= 0 ? (float)c[a] - u[a] : u[a] - (float)c[a] - 1.0f;
+        exit[a] = fmaf(r, n, field_max(e, -1.0f) * n);
+    }
+    return floorf(k + 1.0f + field_min(field_min(exit[0], exit[1]), exit[2]));
 }
 
 /* The raw density d at which a step of step_world reaches opacity `alpha`: alpha >= threshold
@@ -206,7 +224,7 @@ int field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], fl
 
 /* Per-grid constants of a render, computed once per image. */
 typedef struct field_render_grid {
-    float step, scale_step, inv_voxel;
+    float step, scale_step;
     float visible_density; /* raw density below which a sample's alpha is negligible */
     float alpha_per_density; /* table entries per unit of raw density */
     float alpha[FIELD_ALPHA_TABLE + 1]; /* alpha at visible_density + i / alpha_per_density */
@@ -230,11 +248,11 @@ static inline float field_render_alpha(const field_render_grid *r, float d)
     return r->alpha[i] + (u - (float)i) * (r->alpha[i + 1] - r->alpha[i]);
 }
 
-/* The forward march of field_march without recording (same lattice of samples), for
- * rendering: samples under FIELD_VISIBLE_ALPHA are skipped, rays are clipped to the occupied
- * cells, opacity comes from the setup's table (see render_march.c). */
-void field_render_ray(const vf_field *f, const field_render_setup *setup, const field_ray *ray,
-                      float jitter, float min_trans, field_march_result *out);
+/* The forward march of field_march without recording (same lattice of samples) for n rays,
+ * for rendering: samples under FIELD_VISIBLE_ALPHA are skipped, rays are clipped to the
+ * occupied cells, opacity comes from the setup's table (see render_march.c). */
+void field_render_rays(const vf_field *f, const field_render_setup *setup, const field_ray *rays,
+                       int n, float jitter, float min_trans, field_march_result *out);
 
 /* ---- render.c: rays of a camera ------------------------------------------------------- */
 
@@ -243,17 +261,6 @@ void field_render_ray(const vf_field *f, const field_render_setup *setup, const 
  * pixel in OpenCV axes (x right, y down) or NULL for a pinhole computed from the camera. */
 void field_camera_ray(const vf_camera *cam, const double c2w[16], double x, double y,
                       field_ray *ray);
-
-/* Plain comparisons: fminf/fmaxf keep NaN semantics and are library calls unless -ffast-math. */
-static inline float field_min(float a, float b)
-{
-    return a < b ? a : b;
-}
-
-static inline float field_max(float a, float b)
-{
-    return a > b ? a : b;
-}
 
 static inline float field_clamp01(float x)
 {

@@ -64,39 +64,34 @@ static int march_segment(const vf_field *f, int gi, const field_ray *ray, float 
                          float jitter, float min_trans, const float basis[4], march_state *s)
 {
     const field_grid *g = &f->grids[gi];
-    const float step = grid_step(f, g), inv_voxel = 1.0f / g->voxel;
+    const float step = grid_step(f, g);
     const float scale_step = f->density_scale * step, shift = f->density_shift;
-    float og[3], dg[3];
-    for (int a = 0; a < 3; a++) {
-        og[a] = (ray->origin[a] - g->lo[a]) * inv_voxel;
-        dg[a] = ray->dir[a] * inv_voxel;
-    }
-    field_skip skip;
-    field_skip_init(&skip, dg, step);
+    field_lattice lat;
+    field_lattice_init(&lat, g, ray->origin, ray->dir, ta + jitter * step, step);
     const size_t sy = (size_t)g->dim[0], sz = sy * (size_t)g->dim[1];
     const size_t cy = (size_t)g->cells[0], cz = cy * (size_t)g->cells[1];
     /* Offsets of the 8 corners of a cell, in floats. */
     const size_t o1 = FIELD_CH, oy = sy * FIELD_CH, oz = sz * FIELD_CH;
     const int recording = s->rec != NULL;
 
-    for (int k = 0;;) {
-        float t = ta + ((float)k + jitter) * step;
+    for (float k = 0;;) {
+        float t = ta + (k + jitter) * step;
         if (t >= tb)
             return 0;
         int c[3];
         float u[3];
         for (int a = 0; a < 3; a++) {
-            u[a] = og[a] + t * dg[a];
+            u[a] = lat.u0[a] + k * lat.du[a];
             int ci = (int)u[a];
             ci = ci < 0 ? 0 : ci >= g->cells[a] ? g->cells[a] - 1 : ci;
             c[a] = ci;
         }
         int radius = g->empty_radius[(size_t)c[0] + cy * c[1] + cz * c[2]];
         if (radius) { /* empty: jump as far as empty space reaches */
-            k += field_empty_skip(&skip, u, c, radius);
+            k = field_lattice_skip(&lat, k, u, c, radius);
             continue;
         }
-        k++;
+        k += 1.0f;
 
         float fx = field_clamp01(u[0] - (float)c[0]);
         float fy = field_clamp01(u[1] - (float)c[1]);

@@ -54,22 +54,27 @@ static void render_rows(const vf_field *f, const field_render_setup *setup, cons
                         const double c2w[16], float *rgb, float *depth, float *opacity,
                         int parallel)
 {
+    enum { RUN = 64 }; /* pixels of a row marched together (field_render_rays) */
     const int width = cam->width, height = cam->height;
 #pragma omp parallel for schedule(dynamic, 2) if (parallel)
     for (int y = 0; y < height; y++) {
-        for (int x = 0; x < width; x++) {
-            field_ray ray;
-            field_march_result res;
-            field_camera_ray(cam, c2w, x + 0.5, y + 0.5, &ray);
-            field_render_ray(f, setup, &ray, 0.5f, f->stop_transmittance, &res);
-            size_t i = (size_t)y * width + x;
-            if (rgb)
-                memcpy(rgb + 3 * i, res.rgb, sizeof res.rgb);
-            float opaque = 1.0f - res.trans;
-            if (depth)
-                depth[i] = opaque > 1e-4f ? res.depth / opaque : 0.0f;
-            if (opacity)
-                opacity[i] = opaque;
+        for (int x0 = 0; x0 < width; x0 += RUN) {
+            const int n = width - x0 < RUN ? width - x0 : RUN;
+            field_ray rays[RUN];
+            field_march_result res[RUN];
+            for (int j = 0; j < n; j++)
+                field_camera_ray(cam, c2w, x0 + j + 0.5, y + 0.5, &rays[j]);
+            field_render_rays(f, setup, rays, n, 0.5f, f->stop_transmittance, res);
+            for (int j = 0; j < n; j++) {
+                const size_t i = (size_t)y * width + x0 + j;
+                if (rgb)
+                    memcpy(rgb + 3 * i, res[j].rgb, sizeof res[j].rgb);
+                const float opaque = 1.0f - res[j].trans;
+                if (depth)
+                    depth[i] = opaque > 1e-4f ? res[j].depth / opaque : 0.0f;
+                if (opacity)
+                    opacity[i] = opaque;
+            }
         }
     }
 }

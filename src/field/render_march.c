@@ -5,7 +5,10 @@
  *   - the ray is clipped to the box of occupied cells and starts at the first lattice point
  *     inside it;
  *   - empty space is jumped: a sample in an empty cell moves the march as far as the cell's
- *     empty-space radius allows (empty_space.c);
+ *     empty-space radius allows (empty_space.c, field_lattice_skip);
+ *   - four rays are marched in turn: each ray's march is a chain of dependent steps (position,
+ *     cell, radius load, jump), and four independent chains keep the core busy (a real capture
+ *     spends ~40 of its ~75 steps a pixel jumping);
  *   - a sample blends all 16 floats of its 8 corner points as 16-lane vectors (one cache line
  *     each), added as a tree, not as one long chain of dependent additions;
  *   - samples under FIELD_VISIBLE_ALPHA are skipped by a raw-density threshold;
@@ -41,7 +44,6 @@ void field_render_setup_init(const vf_field *f, field_render_setup *setup)
         field_render_grid *r = &setup->grids[i];
         r->step = f->step_ratio * g->voxel;
         r->scale_step = f->density_scale * r->step;
-        r->inv_voxel = 1.0f / g->voxel;
         r->visible_density = field_density_threshold(f, FIELD_VISIBLE_ALPHA, r->step);
         tabulate_alpha(f, r);
         r->empty = 0;
@@ -94,117 +96,193 @@ static inline fast_f4 sample_colour(point_f16 point, point_f16 basis)
     return fast_sigmoid4((b0 + b1) + (b2 + b3));
 }
 
-/* March grid gi over [ta, tb), the lattice anchored at ta. Returns 1 when the ray ended. */
-static int render_segment(const vf_field *f, const field_render_grid *rg, int gi,
-                          const field_ray *ray, float ta, float tb, float jitter, float min_trans,
-                          point_f16 basis, render_state *s)
+/* A stretch of a ray inside one grid: [ta, tb), the lattice anchored at ta. */
+typedef struct ray_segment {
+    int grid;
+    float ta, tb;
+} ray_segment;
+
+/* A ray being marched: its segments in front-to-back order (as field_march: the outer grid in
+ * front of the inner box, the inner box, the outer grid behind it), the segment being marched
+ * and the compositing so far. */
+typedef struct ray_cursor {
+    const field_ray *ray;
+    float jitter;
+    ray_segment segments[3];
+    int segment_count, segment, alive;
+    render_state state;
+    point_f16 basis; /* (1, x, y, z) of the view direction at every colour's lanes */
+    /* the segment being marched */
+    const field_grid *g;
+    const field_render_grid *rg;
+    field_lattice lattice;
+    float k, end;
+    int cells[3];
+    size_t cell_y, cell_z, point_y, point_z; /* strides in cells and in points */
+} ray_cursor;
+
+/* Set up the cursor's current segment, or the first later one with occupied cells on the ray;
+ * the ray is done when none is left. Called a few times a ray: kept out of the hot loop. */
+static __attribute__((noinline)) void cursor_start_segment(ray_cursor *c, const vf_field *f,
+                                                           const field_render_setup *setup)
 {
-    if (rg->empty)
-        return 0;
-    const field_grid *g = &f->grids[gi];
-    field_ray clipped = *ray;
-    clipped.tmin = ta;
-    clipped.tmax = tb;
-    float c0, c1;
-    if (!field_ray_box(&clipped, rg->occ_lo, rg->occ_hi, &c0, &c1))
-        return 0;
-    const float step = rg->step;
-    const float visible = rg->visible_density;
-    /* one lattice point either side of the clipped range: their cells are tested anyway */
-    const float end = field_min(tb, c1 + step);
-    int k = (int)floorf((c0 - ta) / step - jitter);
-    k = k < 0 ? 0 : k;
-
-    float og[3], dg[3];
-    for (int a = 0; a < 3; a++) {
-        og[a] = (ray->origin[a] - g->lo[a]) * rg->inv_voxel;
-        dg[a] = ray->dir[a] * rg->inv_voxel;
-    }
-    field_skip skip;
-    field_skip_init(&skip, dg, step);
-    const int ncx = g->cells[0], ncy = g->cells[1], ncz = g->cells[2];
-    const size_t sy = (size_t)g->dim[0], sz = sy * (size_t)g->dim[1];
-    const size_t cy = (size_t)ncx, cz = cy * (size_t)ncy;
-    const size_t o1 = FIELD_CH, oy = sy * FIELD_CH, oz = sz * FIELD_CH;
-
-    for (;;) {
-        const float t = ta + ((float)k + jitter) * step;
-        if (t >= end)
-            return 0;
-        const float ux = og[0] + t * dg[0], uy = og[1] + t * dg[1], uz = og[2] + t * dg[2];
-        int cx = (int)ux, cyi = (int)uy, czi = (int)uz;
-        cx = cx < 0 ? 0 : cx >= ncx ? ncx - 1 : cx;
-        cyi = cyi < 0 ? 0 : cyi >= ncy ? ncy - 1 : cyi;
-        czi = czi < 0 ? 0 : czi >= ncz ? ncz - 1 : czi;
-        const int radius = g->empty_radius[(size_t)cx + cy * cyi + cz * czi];
-        if (radius) {
-            k += field_empty_skip(&skip, (const float[3]){ux, uy, uz},
-                                  (const int[3]){cx, cyi, czi}, radius);
+    for (; c->segment < c->segment_count; c->segment++) {
+        const ray_segment *sg = &c->segments[c->segment];
+        const field_render_grid *rg = &setup->grids[sg->grid];
+        if (rg->empty)
             continue;
-        }
-        k++;
-
-        const float fx = field_clamp01(ux - (float)cx), fy = field_clamp01(uy - (float)cyi);
-        const float fz = field_clamp01(uz - (float)czi);
-        const size_t base = (size_t)cx + sy * cyi + sz * czi;
-        const float *v = g->values + base * FIELD_CH;
-        const float gx = 1 - fx, gy = 1 - fy, gz = 1 - fz;
-        const float a00 = gx * gy, a10 = fx * gy, a01 = gx * fy, a11 = fx * fy;
-        const float w[8] = {a00 * gz, a10 * gz, a01 * gz, a11 * gz,
-                            a00 * fz, a10 * fz, a01 * fz, a11 * fz};
-        const size_t corner[8] = {0, o1, oy, oy + o1, oz, oz + o1, oz + oy, oz + oy + o1};
-        /* all channels at once: a corner's 16 floats are one vector load */
-        const point_f16 point = trilinear(v, corner, w);
-        const float d = point[FIELD_CH_DENSITY];
-        if (d < visible)
+        field_ray clipped = *c->ray;
+        clipped.tmin = sg->ta;
+        clipped.tmax = sg->tb;
+        float c0, c1;
+        if (!field_ray_box(&clipped, rg->occ_lo, rg->occ_hi, &c0, &c1))
             continue;
-        const float alpha = field_render_alpha(rg, d);
-
-        const float weight = s->trans * alpha;
-        s->rgb += weight * sample_colour(point, basis);
-        s->depth += weight * t;
-        s->count++;
-        s->trans *= 1.0f - alpha;
-        if (s->trans < min_trans)
-            return 1;
+        const field_grid *g = &f->grids[sg->grid];
+        const float step = rg->step;
+        c->g = g;
+        c->rg = rg;
+        /* one lattice point either side of the clipped range: their cells are tested anyway */
+        c->end = field_min(sg->tb, c1 + step);
+        c->k = field_max(floorf((c0 - sg->ta) / step - c->jitter), 0.0f);
+        field_lattice_init(&c->lattice, g, c->ray->origin, c->ray->dir,
+                           sg->ta + c->jitter * step, step);
+        memcpy(c->cells, g->cells, sizeof c->cells);
+        c->cell_y = (size_t)g->cells[0];
+        c->cell_z = c->cell_y * (size_t)g->cells[1];
+        c->point_y = (size_t)g->dim[0];
+        c->point_z = c->point_y * (size_t)g->dim[1];
+        return;
     }
+    c->alive = 0;
 }
 
-void field_render_ray(const vf_field *f, const field_render_setup *setup, const field_ray *ray,
-                      float jitter, float min_trans, field_march_result *out)
+static void cursor_init(ray_cursor *c, const vf_field *f, const field_render_setup *setup,
+                        const field_ray *ray, float jitter)
 {
-    render_state s = {.trans = 1.0f};
+    c->ray = ray;
+    c->jitter = jitter;
+    c->state = (render_state){.trans = 1.0f};
     const float x = ray->dir[0], y = ray->dir[1], z = ray->dir[2];
-    const point_f16 basis = {0, 1, x, y, z, 1, x, y, z, 1, x, y, z, 0, 0, 0};
-    const field_grid *inner = &f->grids[0];
-    const field_render_grid *rg = setup->grids;
-    float i0, i1;
-    int hits_inner = field_ray_box(ray, inner->lo, inner->hi, &i0, &i1);
+    c->basis = (point_f16){0, 1, x, y, z, 1, x, y, z, 1, x, y, z, 0, 0, 0};
+    c->segment_count = 0;
+    float i0, i1, a0, a1;
+    const int hits_inner = field_ray_box(ray, f->grids[0].lo, f->grids[0].hi, &i0, &i1);
     if (f->grid_count == 1) {
         if (hits_inner)
-            render_segment(f, &rg[0], 0, ray, i0, i1, jitter, min_trans, basis, &s);
-    } else {
-        const field_grid *outer = &f->grids[1];
-        float a0, a1;
-        if (field_ray_box(ray, outer->lo, outer->hi, &a0, &a1)) {
-            /* as field_march: outer grid in front of the inner box, the inner box, behind */
-            if (!hits_inner) {
-                render_segment(f, &rg[1], 1, ray, a0, a1, jitter, min_trans, basis, &s);
-            } else {
-                int done = 0;
-                if (a0 < i0)
-                    done = render_segment(f, &rg[1], 1, ray, a0, i0, jitter, min_trans, basis, &s);
-                if (!done)
-                    done = render_segment(f, &rg[0], 0, ray, i0, i1, jitter, min_trans, basis, &s);
-                if (!done && i1 < a1)
-                    render_segment(f, &rg[1], 1, ray, i1, a1, jitter, min_trans, basis, &s);
-            }
+            c->segments[c->segment_count++] = (ray_segment){0, i0, i1};
+    } else if (field_ray_box(ray, f->grids[1].lo, f->grids[1].hi, &a0, &a1)) {
+        if (!hits_inner) {
+            c->segments[c->segment_count++] = (ray_segment){1, a0, a1};
+        } else {
+            if (a0 < i0)
+                c->segments[c->segment_count++] = (ray_segment){1, a0, i0};
+            c->segments[c->segment_count++] = (ray_segment){0, i0, i1};
+            if (i1 < a1)
+                c->segments[c->segment_count++] = (ray_segment){1, i1, a1};
         }
     }
+    c->segment = 0;
+    c->alive = 1;
+    cursor_start_segment(c, f, setup);
+}
+
+/* One step of a live cursor: a jump over empty space, or a sample. */
+static inline void cursor_step(ray_cursor *c, const vf_field *f, const field_render_setup *setup,
+                               float min_trans)
+{
+    const float k = c->k, step = c->rg->step;
+    const float t = c->segments[c->segment].ta + (k + c->jitter) * step;
+    if (t >= c->end) {
+        c->segment++;
+        cursor_start_segment(c, f, setup);
+        return;
+    }
+    const field_grid *g = c->g;
+    const field_lattice *lat = &c->lattice;
+    const float ux = lat->u0[0] + k * lat->du[0], uy = lat->u0[1] + k * lat->du[1];
+    const float uz = lat->u0[2] + k * lat->du[2];
+    int cx = (int)ux, cy = (int)uy, cz = (int)uz;
+    cx = cx < 0 ? 0 : cx >= c->cells[0] ? c->cells[0] - 1 : cx;
+    cy = cy < 0 ? 0 : cy >= c->cells[1] ? c->cells[1] - 1 : cy;
+    cz = cz < 0 ? 0 : cz >= c->cells[2] ? c->cells[2] - 1 : cz;
+    const int radius = g->empty_radius[(size_t)cx + c->cell_y * cy + c->cell_z * cz];
+    if (radius) {
+        c->k = field_lattice_skip(lat, k, (const float[3]){ux, uy, uz}, (const int[3]){cx, cy, cz},
+                                  radius);
+        return;
+    }
+    c->k = k + 1.0f;
+
+    const float fx = field_clamp01(ux - (float)cx), fy = field_clamp01(uy - (float)cy);
+    const float fz = field_clamp01(uz - (float)cz);
+    const size_t base = (size_t)cx + c->point_y * cy + c->point_z * cz;
+    const float *v = g->values + base * FIELD_CH;
+    const float gx = 1 - fx, gy = 1 - fy, gz = 1 - fz;
+    const float a00 = gx * gy, a10 = fx * gy, a01 = gx * fy, a11 = fx * fy;
+    const float w[8] = {a00 * gz, a10 * gz, a01 * gz, a11 * gz,
+                        a00 * fz, a10 * fz, a01 * fz, a11 * fz};
+    const size_t o1 = FIELD_CH, oy = c->point_y * FIELD_CH, oz = c->point_z * FIELD_CH;
+    const size_t corner[8] = {0, o1, oy, oy + o1, oz, oz + o1, oz + oy, oz + oy + o1};
+    /* all channels at once: a corner's 16 floats are one vector load */
+    const point_f16 point = trilinear(v, corner, w);
+    const float d = point[FIELD_CH_DENSITY];
+    if (d < c->rg->visible_density)
+        return;
+    const float alpha = field_render_alpha(c->rg, d);
+
+    render_state *s = &c->state;
+    const float weight = s->trans * alpha;
+    s->rgb += weight * sample_colour(point, c->basis);
+    s->depth += weight * t;
+    s->count++;
+    s->trans *= 1.0f - alpha;
+    if (s->trans < min_trans)
+        c->alive = 0;
+}
+
+static void cursor_finish(const ray_cursor *c, const vf_field *f, field_march_result *out)
+{
+    const render_state *s = &c->state;
     for (int k = 0; k < 3; k++)
-        out->rgb[k] = s.rgb[k] + s.trans * f->background[k];
-    out->trans = s.trans;
-    out->depth = s.depth;
-    out->count = s.count;
+        out->rgb[k] = s->rgb[k] + s->trans * f->background[k];
+    out->trans = s->trans;
+    out->depth = s->depth;
+    out->count = s->count;
     out->overflow = 0;
+}
+
+enum { LANES = 4 }; /* rays marched in turn: 2 were 12% faster than 1, 4 another 5%, 8 slower */
+
+void field_render_rays(const vf_field *f, const field_render_setup *setup, const field_ray *rays,
+                       int n, float jitter, float min_trans, field_march_result *out)
+{
+    int first = 0;
+    for (; first + LANES <= n; first += LANES) {
+        ray_cursor c[LANES];
+        for (int j = 0; j < LANES; j++)
+            cursor_init(&c[j], f, setup, &rays[first + j], jitter);
+        /* in turn while all are live (straight-line code the compiler interleaves), then
+         * whatever is left one by one */
+        for (;;) {
+            int all_alive = 1;
+            for (int j = 0; j < LANES; j++)
+                all_alive &= c[j].alive;
+            if (!all_alive)
+                break;
+            for (int j = 0; j < LANES; j++)
+                cursor_step(&c[j], f, setup, min_trans);
+        }
+        for (int j = 0; j < LANES; j++) {
+            while (c[j].alive)
+                cursor_step(&c[j], f, setup, min_trans);
+            cursor_finish(&c[j], f, &out[first + j]);
+        }
+    }
+    for (; first < n; first++) {
+        ray_cursor c;
+        cursor_init(&c, f, setup, &rays[first], jitter);
+        while (c.alive)
+            cursor_step(&c, f, setup, min_trans);
+        cursor_finish(&c, f, &out[first]);
+    }
 }
