@@ -217,7 +217,17 @@ void field_backward(const vf_field *f, const field_ray *ray, const field_scratch
 /* Clip a ray to a box; returns 0 when it misses. */
 int field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], float *t0, float *t1);
 
-/* ---- render_march.c: one ray, forward only, as fast as it goes -------------------------- */
+/* A stretch [ta, tb) of a ray inside one grid; the march's lattice is anchored at ta. */
+typedef struct field_segment {
+    int grid;
+    float ta, tb;
+} field_segment;
+
+/* The segments of a ray in marching order: the outer grid in front of the inner box, the
+ * inner box, the outer grid behind it. Returns how many (0 to 3). */
+int field_ray_segments(const vf_field *f, const field_ray *ray, field_segment out[3]);
+
+/* ---- render_march.c: rays forward only, as fast as they go ------------------------------ */
 
 /* Opacity of a step as a function of raw density, tabulated (see field_render_setup_init). */
 #define FIELD_ALPHA_TABLE 2048

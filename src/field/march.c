@@ -153,35 +153,38 @@ static int march_segment(const vf_field *f, int gi, const field_ray *ray, float 
     }
 }
 
+int field_ray_segments(const vf_field *f, const field_ray *ray, field_segment out[3])
+{
+    int n = 0;
+    float i0, i1, a0, a1;
+    const int hits_inner = field_ray_box(ray, f->grids[0].lo, f->grids[0].hi, &i0, &i1);
+    if (f->grid_count == 1) {
+        if (hits_inner)
+            out[n++] = (field_segment){0, i0, i1};
+    } else if (field_ray_box(ray, f->grids[1].lo, f->grids[1].hi, &a0, &a1)) {
+        if (!hits_inner) {
+            out[n++] = (field_segment){1, a0, a1};
+        } else {
+            if (a0 < i0)
+                out[n++] = (field_segment){1, a0, i0};
+            out[n++] = (field_segment){0, i0, i1};
+            if (i1 < a1)
+                out[n++] = (field_segment){1, i1, a1};
+        }
+    }
+    return n;
+}
+
 void field_march(const vf_field *f, const field_ray *ray, float jitter, float min_trans,
                  field_scratch *rec, field_march_result *out)
 {
     march_state s = {.trans = 1.0f, .rec = rec};
     const float basis[4] = {1.0f, ray->dir[0], ray->dir[1], ray->dir[2]};
-    const field_grid *inner = &f->grids[0];
-    float i0, i1;
-    int hits_inner = field_ray_box(ray, inner->lo, inner->hi, &i0, &i1);
-    if (f->grid_count == 1) {
-        if (hits_inner)
-            march_segment(f, 0, ray, i0, i1, jitter, min_trans, basis, &s);
-    } else {
-        const field_grid *outer = &f->grids[1];
-        float a0, a1;
-        if (field_ray_box(ray, outer->lo, outer->hi, &a0, &a1)) {
-            /* outer grid in front of the inner box, the inner box, the outer grid behind it */
-            int done = 0;
-            if (!hits_inner) {
-                march_segment(f, 1, ray, a0, a1, jitter, min_trans, basis, &s);
-            } else {
-                if (a0 < i0)
-                    done = march_segment(f, 1, ray, a0, i0, jitter, min_trans, basis, &s);
-                if (!done)
-                    done = march_segment(f, 0, ray, i0, i1, jitter, min_trans, basis, &s);
-                if (!done && i1 < a1)
-                    march_segment(f, 1, ray, i1, a1, jitter, min_trans, basis, &s);
-            }
-        }
-    }
+    field_segment seg[3];
+    const int n = field_ray_segments(f, ray, seg);
+    for (int i = 0; i < n; i++)
+        if (march_segment(f, seg[i].grid, ray, seg[i].ta, seg[i].tb, jitter, min_trans, basis, &s))
+            break;
     for (int k = 0; k < 3; k++)
         out->rgb[k] = s.rgb[k] + s.trans * f->background[k];
     out->trans = s.trans;

@@ -96,19 +96,12 @@ static inline fast_f4 sample_colour(point_f16 point, point_f16 basis)
     return fast_sigmoid4((b0 + b1) + (b2 + b3));
 }
 
-/* A stretch of a ray inside one grid: [ta, tb), the lattice anchored at ta. */
-typedef struct ray_segment {
-    int grid;
-    float ta, tb;
-} ray_segment;
-
-/* A ray being marched: its segments in front-to-back order (as field_march: the outer grid in
- * front of the inner box, the inner box, the outer grid behind it), the segment being marched
- * and the compositing so far. */
+/* A ray being marched: its segments (field_ray_segments), the one being marched and the
+ * compositing so far. */
 typedef struct ray_cursor {
     const field_ray *ray;
     float jitter;
-    ray_segment segments[3];
+    field_segment segments[3];
     int segment_count, segment, alive;
     render_state state;
     point_f16 basis; /* (1, x, y, z) of the view direction at every colour's lanes */
@@ -127,7 +120,7 @@ static __attribute__((noinline)) void cursor_start_segment(ray_cursor *c, const 
                                                            const field_render_setup *setup)
 {
     for (; c->segment < c->segment_count; c->segment++) {
-        const ray_segment *sg = &c->segments[c->segment];
+        const field_segment *sg = &c->segments[c->segment];
         const field_render_grid *rg = &setup->grids[sg->grid];
         if (rg->empty)
             continue;
@@ -164,23 +157,7 @@ static void cursor_init(ray_cursor *c, const vf_field *f, const field_render_set
     c->state = (render_state){.trans = 1.0f};
     const float x = ray->dir[0], y = ray->dir[1], z = ray->dir[2];
     c->basis = (point_f16){0, 1, x, y, z, 1, x, y, z, 1, x, y, z, 0, 0, 0};
-    c->segment_count = 0;
-    float i0, i1, a0, a1;
-    const int hits_inner = field_ray_box(ray, f->grids[0].lo, f->grids[0].hi, &i0, &i1);
-    if (f->grid_count == 1) {
-        if (hits_inner)
-            c->segments[c->segment_count++] = (ray_segment){0, i0, i1};
-    } else if (field_ray_box(ray, f->grids[1].lo, f->grids[1].hi, &a0, &a1)) {
-        if (!hits_inner) {
-            c->segments[c->segment_count++] = (ray_segment){1, a0, a1};
-        } else {
-            if (a0 < i0)
-                c->segments[c->segment_count++] = (ray_segment){1, a0, i0};
-            c->segments[c->segment_count++] = (ray_segment){0, i0, i1};
-            if (i1 < a1)
-                c->segments[c->segment_count++] = (ray_segment){1, i1, a1};
-        }
-    }
+    c->segment_count = field_ray_segments(f, ray, c->segments);
     c->segment = 0;
     c->alive = 1;
     cursor_start_segment(c, f, setup);
