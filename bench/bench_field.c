@@ -29,6 +29,7 @@
 #include "vf/log.h"
 #include "vf/metrics.h"
 #include "vf/pose.h"
+#include "vf/viewfool.h"
 #include "vf/resources.h"
 #include "vf/rng.h"
 
@@ -247,12 +248,12 @@ static void bench_render(const vf_field *f)
     enum { N = 60 };
     double times[N];
     vf_image img = {0};
-    double lo[6], hi[6];
-    vf_viewpoint_bounds(lo, hi);
+    vf_view_bounds box;
+    vf_view_bounds_default(&box);
     for (int i = 0; i < N; i++) {
         double a[6];
         for (int k = 0; k < 6; k++)
-            a[k] = lo[k] + (hi[k] - lo[k]) * vf_rng_uniform(&rng);
+            a[k] = box.lo[k] + (box.hi[k] - box.lo[k]) * vf_rng_uniform(&rng);
         vf_viewpoint v = vf_viewpoint_from_array(a);
         double c2w[16];
         vf_viewpoint_to_c2w(&v, c2w);

@@ -1,5 +1,10 @@
-/* Writing a calibration as the camera file `poses --camera` reads (vf/calib.h). */
+/* The camera file: written by calibration, read by `poses --camera`, `localize`, `reshoot` and
+ * `score --camera` (vf/calib.h). */
 #include "vf/calib.h"
+
+#include <math.h>
+
+#include "vf/workspace.h"
 
 static const char *state_name(int state)
 {
@@ -35,4 +40,61 @@ vf_status vf_calib_save_camera(const char *path, const vf_calib_result *res,
     vf_status status = vf_json_save(path, doc);
     json_decref(doc);
     return status;
+}
+
+/* The number under key (or its alternative), checked against [lo, hi]; whole when asked. */
+static vf_status camera_value(const json_t *doc, const char *path, const char *key,
+                              const char *alt, double lo, double hi, int whole, int required,
+                              double *out)
+{
+    const json_t *x = json_object_get(doc, key);
+    if (!x && alt)
+        x = json_object_get(doc, alt);
+    if (!x && !required) {
+        *out = 0;
+        return VF_OK;
+    }
+    if (!x)
+        return vf_fail(VF_EINPUT, "%s: \"%s\" is missing (need fl_x, fl_y, cx, cy, w and h, in "
+                       "pixels)", path, key);
+    double v = json_is_number(x) ? json_number_value(x) : NAN;
+    if (!(v >= lo && v <= hi) || (whole && v != floor(v)))
+        return vf_fail(VF_EINPUT, "%s: \"%s\" must be a %s from %g to %g", path, key,
+                       whole ? "whole number" : "number", lo, hi);
+    *out = v;
+    return VF_OK;
+}
+
+vf_status vf_calib_load_camera(const char *path, vf_camera *cam)
+{
+    json_t *doc;
+    vf_status s = vf_json_load(path, &doc);
+    if (s != VF_OK)
+        return s;
+    if (!json_is_object(doc)) {
+        json_decref(doc);
+        return vf_fail(VF_EINPUT, "%s is not a camera file (a JSON object with fl_x, fl_y, cx, "
+                       "cy, w, h)", path);
+    }
+    static const struct {
+        const char *key, *alt;
+        double lo, hi;
+        int whole, required;
+    } keys[10] = {
+        {"fl_x", "fx", 1e-6, 1e6, 0, 1}, {"fl_y", "fy", 1e-6, 1e6, 0, 1},
+        {"cx", NULL, 1e-6, 1e6, 0, 1},   {"cy", NULL, 1e-6, 1e6, 0, 1},
+        {"w", "width", 1, 100000, 1, 1}, {"h", "height", 1, 100000, 1, 1},
+        {"k1", NULL, -100, 100, 0, 0},   {"k2", NULL, -100, 100, 0, 0},
+        {"p1", NULL, -100, 100, 0, 0},   {"p2", NULL, -100, 100, 0, 0},
+    };
+    double v[10];
+    for (int i = 0; i < 10 && s == VF_OK; i++)
+        s = camera_value(doc, path, keys[i].key, keys[i].alt, keys[i].lo, keys[i].hi,
+                         keys[i].whole, keys[i].required, &v[i]);
+    json_decref(doc);
+    if (s == VF_OK)
+        *cam = (vf_camera){.width = (int)v[4], .height = (int)v[5], .fx = v[0], .fy = v[1],
+                           .cx = v[2], .cy = v[3], .k1 = v[6], .k2 = v[7], .p1 = v[8],
+                           .p2 = v[9]};
+    return s;
 }

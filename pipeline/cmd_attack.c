@@ -24,7 +24,6 @@
 #define CHECKPOINT "checkpoint.json"
 #define CHECKPOINT_FORMAT 1
 #define LOW_ACCURACY 0.5   /* natural accuracy below this gets a warning */
-#define FIXED_HALF 1e-6    /* half-width of a parameter the search space keeps fixed */
 
 static const char usage[] =
     "usage: vfcapture attack WS [--model NAME|PATH] [--label L1,L2,...]\n"
@@ -44,11 +43,12 @@ static const char usage[] =
     "  -l, --label L1,L2,...  true label set: class indices or names; a view counts as correct\n"
     "                         when the top-1 is any of them (default: the majority top-1 of\n"
     "                         renders at the training poses)\n"
-    "      --method M         nes (the paper's natural-gradient NES, default), pepg (the\n"
-    "                         reference code's variant, lambda 0) or random (the baseline:\n"
-    "                         100 uniform viewpoints)\n"
-    "      --lambda X         entropy weight (default 0.01; 0 for pepg)\n"
-    "  -k, --samples K        viewpoints a step (default 50)\n"
+    "      --method M         nes (the paper's Eq. 7: natural-gradient NES with the entropy\n"
+    "                         term, default), pepg (the reference code's optimizer) or\n"
+    "                         random (the baseline: 100 uniform viewpoints)\n"
+    "      --lambda X         entropy weight (default 0.01): larger keeps p*(v) wider, 0 lets\n"
+    "                         it shrink to a point\n"
+    "  -k, --samples K        viewpoints a step (default 50; pepg 51, the mean and 25 pairs)\n"
     "  -n, --steps N          optimization steps (default 100)\n"
     "      --components K     mixture of K Gaussians, 1..8 (nes only; default 1)\n"
     "      --space S          rotation (offsets fixed at the box centre), translation\n"
@@ -97,6 +97,8 @@ typedef struct attack_run {
     double natural_accuracy;
     vf_attack_config cfg;
     int limited[VF_VIEW_DIM]; /* parameters narrowed to the capture's coverage */
+    int has_natural_best;
+    double natural_best[VF_VIEW_DIM]; /* the training view recognised most confidently */
     vf_stage stage;
     vf_progress progress;
     double seconds_natural, seconds_attack, seconds_eval, seconds_baseline;
@@ -179,8 +181,8 @@ static vf_status parse_options(int argc, char **argv, attack_options *opt)
     opt->workspace = argv[optind];
     if (strcmp(opt->method, "nes") && strcmp(opt->method, "pepg") && strcmp(opt->method, "random"))
         return vf_fail(VF_EINPUT, "--method must be nes, pepg or random, not '%s'", opt->method);
-    if (strcmp(opt->space, "both") && strcmp(opt->space, "rotation") &&
-        strcmp(opt->space, "translation"))
+    vf_view_space space;
+    if (vf_view_space_parse(opt->space, &space) != VF_OK)
         return vf_fail(VF_EINPUT, "--space must be rotation, translation or both, not '%s'",
                        opt->space);
     if (opt->components > 1 && strcmp(opt->method, "nes"))
@@ -277,8 +279,19 @@ static vf_status natural_views(attack_run *run)
     if (s == VF_OK) {
         int correct = 0;
         char names[512];
-        for (int i = 0; i < run->view_count; i++)
-            correct += in_label_set(run, pred[i].top_class);
+        int best = -1;
+        for (int i = 0; i < run->view_count; i++) {
+            int ok = in_label_set(run, pred[i].top_class);
+            correct += ok;
+            if (ok && (best < 0 || pred[i].top_prob > pred[best].top_prob))
+                best = i;
+        }
+        if (best >= 0) {
+            vf_viewpoint v;
+            vf_c2w_to_viewpoint(run->c2w + 16 * best, &v);
+            vf_viewpoint_to_array(&v, run->natural_best);
+            run->has_natural_best = 1;
+        }
         run->natural_accuracy = (double)correct / run->view_count;
         vf_info("natural accuracy: %.0f%% (%d of %d renders at the training poses are {%s})",
                 100 * run->natural_accuracy, correct, run->view_count,
@@ -308,17 +321,30 @@ static vf_status choose_bounds(attack_run *run)
                     "(default [%.3g, %.3g])",
                     param_names[i], b->lo[i], b->hi[i], def.lo[i], def.hi[i]);
         }
-    int rotation_only = !strcmp(run->opt->space, "rotation");
-    int translation_only = !strcmp(run->opt->space, "translation");
-    for (int i = 0; i < VF_VIEW_DIM && s == VF_OK; i++)
-        if ((rotation_only && i >= 3) || (translation_only && i < 3)) {
-            double centre = 0.5 * (b->lo[i] + b->hi[i]);
-            b->lo[i] = centre - FIXED_HALF;
-            b->hi[i] = centre + FIXED_HALF;
-        }
     if (s == VF_OK && run->opt->bounds)
         s = apply_bounds_text(run->opt->bounds, b);
     return s == VF_OK ? vf_view_bounds_check(b) : s;
+}
+
+/* --space rotation|translation: the other parameters stay at the most recognisable natural
+ * view (the box's centre when no view is recognised). */
+static vf_status restrict_space(attack_run *run)
+{
+    vf_view_space space;
+    vf_status s = vf_view_space_parse(run->opt->space, &space);
+    if (s != VF_OK || space == VF_SPACE_BOTH)
+        return s;
+    vf_view_bounds_restrict(&run->cfg.bounds, space,
+                            run->has_natural_best ? run->natural_best : NULL);
+    const vf_view_bounds *b = &run->cfg.bounds;
+    int first = space == VF_SPACE_ROTATION ? 3 : 0;
+    double fixed[3];
+    for (int i = 0; i < 3; i++)
+        fixed[i] = 0.5 * (b->lo[first + i] + b->hi[first + i]);
+    vf_info("%s space: %s fixed at %.3g, %.3g, %.3g%s", run->opt->space,
+            first ? "dx, dy, dz" : "psi, theta, phi", fixed[0], fixed[1], fixed[2],
+            run->has_natural_best ? " (the training view recognised best)" : " (the box centre)");
+    return vf_attack_config_check(&run->cfg);
 }
 
 static vf_status make_config(attack_run *run)
@@ -328,15 +354,13 @@ static vf_status make_config(attack_run *run)
     vf_view_bounds bounds = run->cfg.bounds;
     vf_attack_config_default(&run->cfg, pepg ? VF_ATTACK_PEPG : VF_ATTACK_NES);
     run->cfg.bounds = bounds;
-    run->cfg.samples = opt->samples;
+    if (opt->samples)
+        run->cfg.samples = opt->samples;
     run->cfg.steps = opt->steps;
     run->cfg.components = opt->components;
     run->cfg.seed = opt->seed;
     if (opt->lambda_set)
         run->cfg.lambda = opt->lambda;
-    /* See vf/viewfool.h: with lambda = 0 the natural gradient stalls; use the plain one. */
-    if (!pepg && run->cfg.lambda == 0)
-        run->cfg.natural_gradient = 0;
     return vf_attack_config_check(&run->cfg);
 }
 
@@ -491,6 +515,10 @@ static void print_summary(const attack_run *run, const vf_attack_eval *ev,
     printf("v* = psi %.1f, theta %.1f, phi %.1f deg, dx %.3f, dy %.3f, dz %.3f: '%s' %.0f%% (%s)\n",
            v[0], v[1], v[2], v[3], v[4], v[5], vf_class_short_name(ev->v_star_pred.top_class),
            100.0 * ev->v_star_pred.top_prob, ev->asr_v_star > 0 ? "fooled" : "not fooled");
+    if (strcmp(run->opt->method, "random"))
+        printf("best sample of the last step: '%s' %.0f%% (%s)\n",
+               vf_class_short_name(ev->v_best_pred.top_class), 100.0 * ev->v_best_pred.top_prob,
+               ev->asr_v_best > 0 ? "fooled" : "not fooled");
     printf("ASR of R(v*): %.0f%%   ASR over %d samples of %s: %.0f%%", 100 * ev->asr_v_star,
            ev->sample_count, strcmp(run->opt->method, "random") ? "p*(v)" : "uniform viewpoints",
            100 * ev->asr_samples);
@@ -548,8 +576,6 @@ static vf_status attack_and_report(attack_run *run)
     }
     if (s == VF_OK)
         s = vf_json_save(path, doc);
-    if (s == VF_OK && vf_path_join(path, sizeof path, run->stage.dir, CHECKPOINT) == VF_OK)
-        remove(path);
     if (s == VF_OK) {
         json_t *params = json_pack("{s:s, s:s, s:O, s:O}", "method", run->opt->method, "space",
                                    run->opt->space, "config", json_object_get(doc, "config"),
@@ -558,6 +584,9 @@ static vf_status attack_and_report(attack_run *run)
                                     "asr_v_star", ev->asr_v_star, "asr_samples", ev->asr_samples);
         s = vf_stage_commit(&run->stage, params, summary);
     }
+    /* the checkpoint goes once the stage is in place (a failed commit keeps it for --resume) */
+    if (s == VF_OK && vf_workspace_path(&run->ws, "attack", CHECKPOINT, path, sizeof path) == VF_OK)
+        remove(path);
     if (s == VF_OK) {
         if (run->opt->flags.json)
             cli_print_json(json_incref(doc));
@@ -592,6 +621,8 @@ static vf_status run_attack(attack_run *run)
     if (s == VF_OK)
         s = natural_views(run);
     if (s == VF_OK)
+        s = restrict_space(run);
+    if (s == VF_OK)
         s = attack_and_report(run);
     /* A failure after the stage began leaves its staging folder (and checkpoint) for
      * --resume; the next run without --resume clears it. */
@@ -606,7 +637,7 @@ static vf_status run_attack(attack_run *run)
 int cmd_attack(int argc, char **argv)
 {
     attack_options opt = {.model = VF_DEFAULT_MODEL, .method = "nes", .space = "both",
-                          .samples = 50, .steps = 100, .components = 1};
+                          .steps = 100, .components = 1};
     attack_run run = {.opt = &opt};
     vf_status status = parse_options(argc, argv, &opt);
     if (status == VF_OK)

@@ -125,8 +125,12 @@ static vf_status choose_targets(export_run *run)
         free(picked);
         return vf_fail(VF_EINTERNAL, "out of memory");
     }
-    vf_targets_spread(run->attack.samples, run->attack.sample_count, run->attack.lo,
-                      run->attack.hi, m, picked);
+    vf_status status = vf_targets_spread(run->attack.samples, run->attack.sample_count,
+                                         run->attack.range, m, picked);
+    if (status != VF_OK) {
+        free(picked);
+        return status;
+    }
     run->targets[0] = (target){.v = run->attack.v_star, .kind = "v*", .sample = -1,
                                .pred = run->attack.v_star_prediction};
     for (int k = 0; k < m; k++) {

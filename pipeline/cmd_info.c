@@ -13,6 +13,12 @@ static const char usage[] =
     "\n"
     "options:\n" CLI_COMMON_HELP;
 
+/* A manifest's string, or "?" when a hand-edited or foreign manifest lacks it. */
+static const char *text_or(const json_t *x)
+{
+    return json_is_string(x) ? json_string_value(x) : "?";
+}
+
 int cmd_info(int argc, char **argv)
 {
     static const struct option longopts[] = {CLI_COMMON_OPTIONS, {0, 0, 0, 0}};
@@ -32,14 +38,14 @@ int cmd_info(int argc, char **argv)
         cli_print_json(json_incref(ws.manifest));
     } else {
         printf("workspace %s (created by vfcapture %s)\n", ws.root,
-               json_string_value(json_object_get(ws.manifest, "version")));
+               text_or(json_object_get(ws.manifest, "version")));
         const char *name;
         json_t *record;
         json_object_foreach(json_object_get(ws.manifest, "stages"), name, record)
         {
             char *summary = json_dumps(json_object_get(record, "summary"), JSON_COMPACT);
             printf("  %-8s done %s in %.1f s  %s\n", name,
-                   json_string_value(json_object_get(record, "completed")),
+                   text_or(json_object_get(record, "completed")),
                    json_number_value(json_object_get(record, "seconds")), summary ? summary : "");
             free(summary);
         }

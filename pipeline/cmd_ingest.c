@@ -37,7 +37,9 @@ static const char usage[] =
     "  -o, --output WS        workspace folder (required)\n"
     "  -n, --frames N         keep at most N frames (default 100)\n"
     "      --max-size PX      shrink frames to at most PX on the longer side (default 1024)\n"
-    "      --blur-ratio R     reject frames below R x the local median sharpness (default 0.4)\n"
+    "      --blur-ratio R     reject frames below R x the local median sharpness (default 0.4);\n"
+    "                         photos: below R x the median of all photos (default 0.2, so\n"
+    "                         only the truly unusable: a folder has no order to compare in)\n"
     "      --duplicate-threshold D\n"
     "                         frames whose thumbnails differ by less than D grey levels are\n"
     "                         repeats (default 1.5)\n"
@@ -111,7 +113,11 @@ static vf_status apply_option(int c, const char *arg, ingest_options *opt)
         cap->max_size = (int)n;
         return VF_OK;
     case OPT_BLUR_RATIO:
-        return parse_number(arg, "--blur-ratio", 0, 0.99, &cap->select.blur_ratio);
+        /* one knob for both rules (the local one of videos, the global one of photos) */
+        if (parse_number(arg, "--blur-ratio", 0, 0.99, &cap->select.blur_ratio) != VF_OK)
+            return VF_EINPUT;
+        cap->photo_blur_ratio = cap->select.blur_ratio;
+        return VF_OK;
     case OPT_DUPLICATE_THRESHOLD:
         return parse_number(arg, "--duplicate-threshold", 0, 255,
                             &cap->select.duplicate_threshold);

@@ -197,9 +197,9 @@ static vf_status handle_frame(reshoot_run *run, const vf_rgb8 *frame, const fram
         vf_pose_smoother_add(&run->smoother, r.c2w_object, smooth);
         vf_viewpoint sv;
         vf_c2w_to_viewpoint(smooth, &sv);
-        int raw_in = physical_within_box(&r.viewpoint, &run->target_v, run->attack.lo,
-                                         run->attack.hi, run->opt->tolerance, &box_raw);
-        int smooth_in = physical_within_box(&sv, &run->target_v, run->attack.lo, run->attack.hi,
+        int raw_in = physical_within_box(&r.viewpoint, &run->target_v, run->attack.range,
+                                         run->opt->tolerance, &box_raw);
+        int smooth_in = physical_within_box(&sv, &run->target_v, run->attack.range,
                                             run->opt->tolerance, &box_smooth);
         vf_advice a;
         vf_advice_compute(smooth, run->target_c2w, &a);
@@ -293,11 +293,19 @@ static vf_status reshoot(const reshoot_options *o, vf_workspace *ws, reshoot_run
     status = vf_path_join(run->frames_dir, sizeof run->frames_dir, stage.dir, "frames");
     if (status == VF_OK)
         status = vf_mkdirs(run->frames_dir);
-    if (status == VF_OK)
-        status = capture(run);
+    /* A capture that stops early (a webcam unplugged, a frame of another size) keeps the
+     * frames already on target: they are committed, and the error is returned after. */
+    vf_status stopped = VF_OK;
+    char stop_message[1024] = "";
+    if (status == VF_OK && (stopped = capture(run)) != VF_OK && json_array_size(run->saved) == 0)
+        status = stopped;
+    else if (stopped != VF_OK)
+        snprintf(stop_message, sizeof stop_message, "%s", vf_error_message());
     json_t *doc = json_pack("{s:i, s:o, s:f, s:O}", "target", o->target, "target_viewpoint",
                             physical_viewpoint_json(&run->target_v), "tolerance_percent",
                             100 * o->tolerance, "frames", run->saved);
+    if (stop_message[0])
+        json_object_set_new(doc, "stopped_early", json_string(stop_message));
     if (status == VF_OK && (status = vf_path_join(path, sizeof path, stage.dir, "poses.json")) ==
                                VF_OK)
         status = vf_json_save(path, doc);
@@ -310,6 +318,9 @@ static vf_status reshoot(const reshoot_options *o, vf_workspace *ws, reshoot_run
                                            (int)json_array_size(run->saved)));
     else
         vf_stage_abort(&stage);
+    if (status == VF_OK && stop_message[0])
+        status = vf_fail(stopped, "%s (the %zu frames on target before it are kept in %s/%s)",
+                         stop_message, json_array_size(run->saved), o->workspace, stage_name);
     return status;
 }
 

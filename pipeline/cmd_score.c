@@ -251,7 +251,7 @@ static vf_status score_frame(score_run *run, const vf_rgb8 *frame, const frame_i
         return VF_OK;
     }
     double worst;
-    int inside = physical_within_box(&r.viewpoint, &run->center, run->attack.lo, run->attack.hi,
+    int inside = physical_within_box(&r.viewpoint, &run->center, run->attack.range,
                                      run->opt->tolerance, &worst);
     json_object_set_new(row, "viewpoint", physical_viewpoint_json(&r.viewpoint));
     json_object_set_new(row, "box_distance", json_real(worst));

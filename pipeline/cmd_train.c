@@ -265,7 +265,6 @@ static vf_status train(const train_options *opt, vf_workspace *ws)
         if (held)
             json_object_update_new(report, json_pack("{s:f, s:f}", "held_out_psnr", psnr,
                                                      "held_out_ssim", ssim));
-        remove(checkpoint);
         status = vf_path_join(report_path, sizeof report_path, stage.dir, "report.json");
     }
     if (status == VF_OK)
@@ -285,6 +284,11 @@ static vf_status train(const train_options *opt, vf_workspace *ws)
                                        opt->steps, "holdout", opt->holdout, "keep_background",
                                        opt->keep_background),
                              json_incref(summary));
+    /* The checkpoint goes only once the stage is in place: after a failed commit the next run
+     * resumes from it at its end instead of training again. */
+    if (status == VF_OK && vf_workspace_path(ws, "train", CHECKPOINT_FILE, checkpoint,
+                                             sizeof checkpoint) == VF_OK)
+        remove(checkpoint);
     if (status == VF_OK)
         status = vf_workspace_path(ws, "train", "model.vff", model, sizeof model);
     if (status == VF_OK) {

@@ -5,28 +5,9 @@
 #include <math.h>
 #include <stdio.h>
 
+#include "vf/calib.h"
+#include "vf/targets.h"
 #include "vf/workspace.h"
-
-vf_status physical_load_camera(const char *path, vf_camera *cam)
-{
-    json_t *doc;
-    vf_status status = vf_json_load(path, &doc);
-    if (status != VF_OK)
-        return status;
-    static const char *const keys[10] = {"fl_x", "fl_y", "cx", "cy", "w",
-                                         "h",    "k1",   "k2", "p1", "p2"};
-    double v[10];
-    for (int i = 0; i < 10; i++) {
-        json_t *x = json_object_get(doc, keys[i]);
-        v[i] = json_is_number(x) ? json_number_value(x) : 0;
-    }
-    json_decref(doc);
-    if (!(v[0] > 0 && v[1] > 0 && v[2] > 0 && v[3] > 0 && v[4] >= 1 && v[5] >= 1))
-        return vf_fail(VF_EINPUT, "%s: need fl_x, fl_y, cx, cy, w and h (pixels)", path);
-    *cam = (vf_camera){.width = (int)v[4], .height = (int)v[5], .fx = v[0], .fy = v[1],
-                       .cx = v[2], .cy = v[3], .k1 = v[6], .k2 = v[7], .p1 = v[8], .p2 = v[9]};
-    return VF_OK;
-}
 
 vf_status physical_localize_option(int opt, const char *arg, vf_localize_options *lo,
                                    int *handled)
@@ -37,7 +18,7 @@ vf_status physical_localize_option(int opt, const char *arg, vf_localize_options
     switch (opt) {
     case PHYS_OPT_CAMERA:
         lo->has_camera = 1;
-        return physical_load_camera(arg, &lo->camera);
+        return vf_calib_load_camera(arg, &lo->camera);
     case PHYS_OPT_MIN_INLIERS:
         if (cli_parse_int(arg, 6, 100000, &n))
             return vf_fail(VF_EINPUT, "--min-inliers: give a number from 6 to 100000");
@@ -99,8 +80,8 @@ void physical_viewpoint_text(const vf_viewpoint *v, char *out, size_t size)
              v->phi, v->dx, v->dy, v->dz);
 }
 
-int physical_within_box(const vf_viewpoint *v, const vf_viewpoint *center, const double lo[6],
-                        const double hi[6], double tolerance, double *worst)
+int physical_within_box(const vf_viewpoint *v, const vf_viewpoint *center, const double range[6],
+                        double tolerance, double *worst)
 {
     double a[6], c[6], largest = 0;
     vf_viewpoint_to_array(v, a);
@@ -109,7 +90,7 @@ int physical_within_box(const vf_viewpoint *v, const vf_viewpoint *center, const
         double d = a[i] - c[i];
         if (i == 0)
             d = remainder(d, 360.0);
-        double share = fabs(d) / (hi[i] - lo[i]);
+        double share = fabs(d) / range[i];
         largest = share > largest ? share : largest;
     }
     if (worst)
@@ -120,26 +101,12 @@ int physical_within_box(const vf_viewpoint *v, const vf_viewpoint *center, const
 vf_status physical_load_target(const char *ws, int n, vf_viewpoint *v, double c2w[16])
 {
     char path[VF_PATH_MAX];
-    json_t *doc;
     vf_status status = vf_path_join(path, sizeof path, ws, "export/targets.json");
     if (status == VF_OK && !vf_is_file(path))
         return vf_fail(VF_EINPUT, "%s does not exist: run 'vfcapture export %s' first", path, ws);
     if (status == VF_OK)
-        status = vf_json_load(path, &doc);
-    if (status != VF_OK)
-        return status;
-    json_t *targets = json_object_get(doc, "targets");
-    json_t *vp = json_object_get(json_array_get(targets, (size_t)n), "viewpoint");
-    double a[6];
-    int ok = json_array_size(vp) == 6;
-    for (int i = 0; ok && i < 6; i++)
-        a[i] = json_number_value(json_array_get(vp, i));
-    size_t count = json_array_size(targets);
-    json_decref(doc);
-    if (!ok)
-        return vf_fail(VF_EINPUT, "%s has no target %d (it lists %zu, from 0)", path, n, count);
-    *v = vf_viewpoint_from_array(a);
-    if (c2w)
+        status = vf_targets_file_target(path, n, v);
+    if (status == VF_OK && c2w)
         vf_viewpoint_to_c2w(v, c2w);
-    return VF_OK;
+    return status;
 }

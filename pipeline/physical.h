@@ -39,9 +39,6 @@ enum {
 vf_status physical_localize_option(int opt, const char *arg, vf_localize_options *lo,
                                    int *handled);
 
-/* A camera JSON file (fl_x, fl_y, cx, cy, w, h, optional k1, k2, p1, p2). */
-vf_status physical_load_camera(const char *path, vf_camera *cam);
-
 /* The viewpoint (and, c2w not NULL, the object-frame camera-to-world) of exported target n
  * of WS/export/targets.json. VF_EINPUT when there is no export or no such target. */
 vf_status physical_load_target(const char *ws, int n, vf_viewpoint *v, double c2w[16]);
@@ -55,9 +52,9 @@ json_t *physical_mat4_json(const double m[16]);
 void physical_viewpoint_text(const vf_viewpoint *v, char *out, size_t size);
 
 /* Whether viewpoint v lies within +-tolerance (a share, 0.05 for 5%) of each parameter's
- * range (hi - lo) around `center`; psi differences wrap around 360 degrees. *worst (may be
- * NULL) receives the largest |difference| / range over the parameters. */
-int physical_within_box(const vf_viewpoint *v, const vf_viewpoint *center, const double lo[6],
-                        const double hi[6], double tolerance, double *worst);
+ * measurement range (vf_attack_file.range) around `center`; psi differences wrap around 360
+ * degrees. *worst (may be NULL) receives the largest |difference| / range. */
+int physical_within_box(const vf_viewpoint *v, const vf_viewpoint *center, const double range[6],
+                        double tolerance, double *worst);
 
 #endif

@@ -11,11 +11,13 @@
 #include "vf/sfm_images.h"
 #include "vf/workspace.h"
 
+#define RETRIEVAL_IMAGES 40 /* retrieval matching: each frame with this many most similar */
+
 typedef struct poses_options {
     const char *workspace;
-    const char *matcher;      /* "auto", "sequential", "exhaustive" */
+    const char *matcher;      /* "auto", "sequential", "exhaustive", "retrieval" */
     const char *camera_model; /* "auto" or a COLMAP model name */
-    const char *vocab_tree;   /* for sequential loop detection, or NULL */
+    const char *vocab_tree;   /* a tree for loop detection and retrieval, or NULL: build one */
     int overlap;              /* sequential matching: neighbours per frame */
     int max_features;
     double min_registered;    /* share of frames that must register */

@@ -168,20 +168,41 @@ void vf_softmax(float *values, int n)
         values[i] = (float)(values[i] / sum);
 }
 
-vf_status vf_classifier_forward(vf_classifier *cls, const float *batch_nchw, int n,
-                                float *probs_out)
+vf_status vf_classifier_logits(vf_classifier *cls, const float *batch_nchw, int n,
+                               float *logits_out)
 {
     if (n <= 0)
         return vf_fail(VF_EINPUT, "nothing to classify (batch of %d)", n);
     vf_status status =
-        vf_dnn_forward(cls->dnn, batch_nchw, n, cls->input_size, probs_out, VF_NUM_CLASSES);
-    if (status != VF_OK) {
+        vf_dnn_forward(cls->dnn, batch_nchw, n, cls->input_size, logits_out, VF_NUM_CLASSES);
+    if (status != VF_OK)
         vf_error_prefix("model %s", cls->path);
-        return status;
-    }
-    for (int i = 0; i < n; i++)
+    return status;
+}
+
+vf_status vf_classifier_forward(vf_classifier *cls, const float *batch_nchw, int n,
+                                float *probs_out)
+{
+    vf_status status = vf_classifier_logits(cls, batch_nchw, n, probs_out);
+    for (int i = 0; status == VF_OK && i < n; i++)
         vf_softmax(probs_out + (size_t)i * VF_NUM_CLASSES, VF_NUM_CLASSES);
-    return VF_OK;
+    return status;
+}
+
+/* log sum_i exp(x[idx_i]) (all n when idx is NULL), in double around the largest term. */
+static double log_sum_exp(const float *x, const int *idx, int n)
+{
+    double top = -INFINITY, sum = 0.0;
+    for (int i = 0; i < n; i++)
+        top = fmax(top, (double)x[idx ? idx[i] : i]);
+    for (int i = 0; i < n; i++)
+        sum += exp((double)x[idx ? idx[i] : i] - top);
+    return top + log(sum);
+}
+
+double vf_label_set_cross_entropy(const float *logits, const int *labels, int count)
+{
+    return log_sum_exp(logits, NULL, VF_NUM_CLASSES) - log_sum_exp(logits, labels, count);
 }
 
 /* Preprocess images[0..n) into batch in parallel. Errors happen on worker threads, whose

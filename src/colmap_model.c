@@ -216,7 +216,8 @@ static vf_status load_points(const char *dir, vf_colmap_model *m)
             m->point_count++;
     }
     reader_close(&r);
-    for (int i = 0; i < m->point_count; i++)
+    /* tracks were read as offsets into the pool (which stays NULL when no point has one) */
+    for (int i = 0; m->track_pool && i < m->point_count; i++)
         m->points[i].track = m->track_pool + (intptr_t)m->points[i].track;
     return status;
 }

@@ -21,6 +21,17 @@ static double number_or(const json_t *obj, const char *key, double fallback)
     return json_is_number(v) ? json_number_value(v) : fallback;
 }
 
+/* An image size: a whole number from 1 to 100000, else -1 (refused later); fallback when
+ * absent. Never a cast of an arbitrary double to int. */
+static int size_or(const json_t *obj, const char *key, int fallback)
+{
+    const json_t *v = json_object_get(obj, key);
+    if (!v)
+        return fallback;
+    double x = json_is_number(v) ? json_number_value(v) : NAN;
+    return x >= 1 && x <= 100000 && x == floor(x) ? (int)x : -1;
+}
+
 /* Fields in `obj` override those already in `in` (top level first, then per frame). */
 static void read_intrinsics(const json_t *obj, stated_intrinsics *in)
 {
@@ -33,14 +44,16 @@ static void read_intrinsics(const json_t *obj, stated_intrinsics *in)
     in->k2 = number_or(obj, "k2", in->k2);
     in->p1 = number_or(obj, "p1", in->p1);
     in->p2 = number_or(obj, "p2", in->p2);
-    in->w = (int)number_or(obj, "w", in->w);
-    in->h = (int)number_or(obj, "h", in->h);
+    in->w = size_or(obj, "w", in->w);
+    in->h = size_or(obj, "h", in->h);
 }
 
 /* Turn what the file states into a camera for an image of the real size. A file whose w/h
  * differ from the image by a uniform scale (images resized after posing) is scaled. */
 static vf_status resolve_camera(const stated_intrinsics *in, int img_w, int img_h, vf_camera *cam)
 {
+    if (in->w < 0 || in->h < 0)
+        return vf_fail(VF_EINPUT, "w and h must be whole numbers of pixels from 1 to 100000");
     int w = in->w > 0 ? in->w : img_w, h = in->h > 0 ? in->h : img_h;
     memset(cam, 0, sizeof *cam);
     cam->width = w;
@@ -59,6 +72,11 @@ static vf_status resolve_camera(const stated_intrinsics *in, int img_w, int img_
     cam->k2 = in->k2;
     cam->p1 = in->p1;
     cam->p2 = in->p2;
+    if (!(cam->fx < 1e7 && cam->fy < 1e7 && fabs(cam->cx) < 1e7 && fabs(cam->cy) < 1e7 &&
+          fabs(cam->k1) <= 100 && fabs(cam->k2) <= 100 && fabs(cam->p1) <= 100 &&
+          fabs(cam->p2) <= 100))
+        return vf_fail(VF_EINPUT, "the camera's focal length, principal point or distortion is "
+                       "out of range");
     if (w != img_w || h != img_h) {
         double sx = (double)img_w / w, sy = (double)img_h / h;
         if (fabs(sx - sy) > 0.01 * sx)
@@ -79,8 +97,9 @@ static vf_status read_matrix(const json_t *rows, double m[16])
                 continue;
             }
             const json_t *v = json_array_get(json_array_get(rows, (size_t)r), (size_t)c);
-            if (!json_is_number(v))
-                return vf_fail(VF_EINPUT, "transform_matrix[%d][%d] is not a number", r, c);
+            if (!json_is_number(v) || !(fabs(json_number_value(v)) <= 1e6))
+                return vf_fail(VF_EINPUT, "transform_matrix[%d][%d] is not a number from -1e6 "
+                               "to 1e6", r, c);
             m[4 * r + c] = json_number_value(v);
         }
     return VF_OK;

@@ -14,6 +14,7 @@ void vf_select_defaults(vf_select_params *params)
     params->blur_ratio = 0.4;
     params->blur_window = 7;
     params->duplicate_threshold = 1.5;
+    params->unordered = 0;
 }
 
 const char *vf_frame_verdict_name(vf_frame_verdict verdict)
@@ -79,6 +80,19 @@ static vf_status alloc_selection(int count, vf_selection *s)
 static void reject_blurry(const vf_frame_score *scores, const vf_select_params *p, vf_selection *s)
 {
     double window[LIVE_RING];
+    double *all = p->unordered && s->count > 0 ? malloc((size_t)s->count * sizeof *all) : NULL;
+    if (all) {
+        for (int i = 0; i < s->count; i++)
+            all[i] = scores[i].sharpness;
+        double global = median(all, s->count);
+        for (int i = 0; i < s->count; i++) {
+            s->local_median[i] = global;
+            if (scores[i].sharpness < p->blur_ratio * global)
+                s->verdict[i] = VF_FRAME_BLURRY;
+        }
+        free(all);
+        return;
+    }
     for (int i = 0; i < s->count; i++) {
         int lo = i - p->blur_window < 0 ? 0 : i - p->blur_window;
         int hi = i + p->blur_window >= s->count ? s->count - 1 : i + p->blur_window;

@@ -17,6 +17,7 @@ void vf_ingest_defaults(vf_ingest_options *options)
     memset(options, 0, sizeof *options);
     vf_select_defaults(&options->select);
     options->max_size = 1024;
+    options->photo_blur_ratio = 0.2;
     options->seconds = 10;
     options->width = 1280;
     options->height = 720;
@@ -48,6 +49,19 @@ void score_list_free(score_list *list)
 {
     free(list->items);
     memset(list, 0, sizeof *list);
+}
+
+void vf_ingest_source_kind(const char *ws_root, char *kind, size_t size)
+{
+    char path[VF_PATH_MAX];
+    json_t *doc = NULL;
+    snprintf(kind, size, "%s", "");
+    if (vf_path_join(path, sizeof path, ws_root, "ingest/" INGEST_REPORT) != VF_OK ||
+        !vf_is_file(path) || vf_json_load(path, &doc) != VF_OK)
+        return;
+    const char *k = json_string_value(json_object_get(json_object_get(doc, "source"), "kind"));
+    snprintf(kind, size, "%s", k ? k : "");
+    json_decref(doc);
 }
 
 json_t *ingest_report_new(const char *kind, const char *path)

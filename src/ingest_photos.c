@@ -191,7 +191,10 @@ vf_status vf_ingest_photos(const char *folder, const vf_ingest_options *options,
         vf_info("%s: %d photos", folder, list.count);
         report = ingest_report_new("photos", folder);
         describe_photos(report, folder, &list, sizes);
-        status = ingest_select(&scores, &options->select, folder, report, &sel);
+        vf_select_params select = options->select;
+        select.unordered = 1;
+        select.blur_ratio = options->photo_blur_ratio;
+        status = ingest_select(&scores, &select, folder, report, &sel);
     }
     if (status == VF_OK)
         status = ingest_make_images_dir(out_dir, images_dir);

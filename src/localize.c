@@ -39,14 +39,32 @@ static vf_status read_similarity(const json_t *obj, const char *path, const char
     const json_t *o = json_object_get(obj, key);
     const json_t *rot = json_object_get(o, "rotation"), *t = json_object_get(o, "translation");
     s->scale = json_number_value(json_object_get(o, "scale"));
-    if (!(s->scale > 0) || json_array_size(rot) != 3 || json_array_size(t) != 3)
-        return vf_fail(VF_EINPUT, "%s: \"%s\" needs scale, rotation (3x3) and translation",
-                       path, key);
-    for (int r = 0; r < 3; r++) {
-        s->t[r] = json_number_value(json_array_get(t, r));
-        for (int c = 0; c < 3; c++)
-            s->R[3 * r + c] = json_number_value(json_array_get(json_array_get(rot, r), c));
+    int ok = s->scale > 1e-9 && s->scale < 1e9 && json_array_size(rot) == 3 &&
+             json_array_size(t) == 3;
+    for (int r = 0; ok && r < 3; r++) {
+        const json_t *row = json_array_get(rot, (size_t)r);
+        s->t[r] = json_number_value(json_array_get(t, (size_t)r));
+        ok = json_array_size(row) == 3 && json_is_number(json_array_get(t, (size_t)r)) &&
+             fabs(s->t[r]) < 1e9;
+        for (int c = 0; ok && c < 3; c++) {
+            const json_t *x = json_array_get(row, (size_t)c);
+            s->R[3 * r + c] = json_number_value(x);
+            ok = json_is_number(x);
+        }
     }
+    /* a rotation: orthonormal rows (R R^T = I) and det +1 */
+    for (int a = 0; ok && a < 3; a++)
+        for (int b = 0; ok && b < 3; b++) {
+            double dot = 0;
+            for (int k = 0; k < 3; k++)
+                dot += s->R[3 * a + k] * s->R[3 * b + k];
+            ok = fabs(dot - (a == b)) < 1e-6;
+        }
+    if (ok)
+        ok = vf_mat3_det(s->R) > 0;
+    if (!ok)
+        return vf_fail(VF_EINPUT, "%s: \"%s\" needs a scale (1e-9 to 1e9), a rotation (3x3, "
+                       "orthonormal) and a translation (3 numbers)", path, key);
     return VF_OK;
 }
 

@@ -9,7 +9,6 @@
 static int quiet_mode;
 
 void vf_log_set_quiet(int quiet) { quiet_mode = quiet; }
-int vf_log_is_quiet(void) { return quiet_mode; }
 
 double vf_now(void)
 {

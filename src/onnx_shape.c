@@ -1,6 +1,7 @@
 /* A minimal protobuf walker, just enough to read an ONNX model's input shape. */
 #include "onnx_shape.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* Field numbers from onnx.proto. */
@@ -82,21 +83,42 @@ static pb_reader pb_find(pb_reader msg, int number)
     return (pb_reader){NULL, NULL};
 }
 
-static int same_bytes(pb_reader a, pb_reader b)
+/* Order of names: by length, then bytes (for qsort and bsearch). */
+static int compare_names(const void *pa, const void *pb)
 {
-    size_t n = (size_t)(a.end - a.p);
-    return n == (size_t)(b.end - b.p) && (n == 0 || memcmp(a.p, b.p, n) == 0);
+    const pb_reader *a = pa, *b = pb;
+    size_t na = (size_t)(a->end - a->p), nb = (size_t)(b->end - b->p);
+    if (na != nb)
+        return na < nb ? -1 : 1;
+    return na ? memcmp(a->p, b->p, na) : 0;
 }
 
-/* Older exporters list the weights among the graph inputs too: skip those. */
-static int is_initializer(pb_reader graph, pb_reader name)
+/* The names of the graph's initializers, sorted (*count of them; NULL when none or out of
+ * memory, which only costs the skipping below). Older exporters also list every weight among
+ * the inputs, so a model can have thousands of each: one sorted list keeps this n log n. */
+static pb_reader *initializer_names(pb_reader graph, size_t *count)
 {
     pb_field f;
-    while (pb_next(&graph, &f))
-        if (f.number == GRAPH_INITIALIZER && f.wire == 2 &&
-            same_bytes(pb_find(f.sub, TENSOR_NAME), name))
-            return 1;
-    return 0;
+    size_t n = 0, cap = 0;
+    pb_reader *names = NULL;
+    *count = 0;
+    while (pb_next(&graph, &f)) {
+        if (f.number != GRAPH_INITIALIZER || f.wire != 2)
+            continue;
+        if (n == cap) {
+            size_t grown_cap = cap ? 2 * cap : 64;
+            pb_reader *grown = realloc(names, grown_cap * sizeof *names);
+            if (!grown)
+                break;
+            names = grown;
+            cap = grown_cap;
+        }
+        names[n++] = pb_find(f.sub, TENSOR_NAME);
+    }
+    if (n)
+        qsort(names, n, sizeof *names, compare_names);
+    *count = n;
+    return names;
 }
 
 static int read_dims(pb_reader value_info, long long *dims, int max)
@@ -120,13 +142,20 @@ static int read_dims(pb_reader value_info, long long *dims, int max)
 int vf_onnx_input_dims(const unsigned char *data, size_t size, long long *dims, int max)
 {
     pb_reader graph = pb_find((pb_reader){data, data + size}, MODEL_GRAPH);
+    size_t init_count;
+    pb_reader *inits = initializer_names(graph, &init_count);
     pb_reader inputs = graph;
     pb_field f;
+    int found = 0;
     while (pb_next(&inputs, &f)) {
         if (f.number != GRAPH_INPUT || f.wire != 2)
             continue;
-        if (!is_initializer(graph, pb_find(f.sub, VALUE_INFO_NAME)))
-            return read_dims(f.sub, dims, max);
+        pb_reader name = pb_find(f.sub, VALUE_INFO_NAME);
+        if (!inits || !bsearch(&name, inits, init_count, sizeof *inits, compare_names)) {
+            found = read_dims(f.sub, dims, max);
+            break;
+        }
     }
-    return 0;
+    free(inits);
+    return found;
 }

@@ -516,14 +516,6 @@ void vf_c2w_to_viewpoint(const double c2w[16], vf_viewpoint *out)
     out->dy = local[2] - VF_CAMERA_DISTANCE;
 }
 
-void vf_viewpoint_bounds(double lo[VF_VIEWPOINT_DIMS], double hi[VF_VIEWPOINT_DIMS])
-{
-    static const double default_lo[VF_VIEWPOINT_DIMS] = {-180, -30, 20, -0.5, -1, -0.5};
-    static const double default_hi[VF_VIEWPOINT_DIMS] = {180, 30, 160, 0.5, 1, 0.5};
-    memcpy(lo, default_lo, sizeof default_lo);
-    memcpy(hi, default_hi, sizeof default_hi);
-}
-
 void vf_viewpoint_to_array(const vf_viewpoint *v, double a[VF_VIEWPOINT_DIMS])
 {
     a[0] = v->psi, a[1] = v->theta, a[2] = v->phi;

@@ -12,14 +12,17 @@
 
 /* ---- attack.json ---- */
 
+/* Six viewpoint numbers (psi, theta, phi, dx, dy, dz, or ranges of them): angles within two
+ * turns, offsets within 100 camera distances, so nothing later renders from infinity. */
 static int read_six(const json_t *arr, double out[6])
 {
     if (json_array_size(arr) != 6)
         return 0;
     for (int i = 0; i < 6; i++) {
-        if (!json_is_number(json_array_get(arr, i)))
+        const json_t *x = json_array_get(arr, (size_t)i);
+        if (!json_is_number(x) || !(fabs(json_number_value(x)) <= (i < 3 ? 720.0 : 400.0)))
             return 0;
-        out[i] = json_number_value(json_array_get(arr, i));
+        out[i] = json_number_value(x);
     }
     return 1;
 }
@@ -66,11 +69,29 @@ static void read_camera(const json_t *doc, vf_attack_file *a)
     double fx = number_or_nan(c, "fl_x"), fy = number_or_nan(c, "fl_y");
     double cx = number_or_nan(c, "cx"), cy = number_or_nan(c, "cy");
     double w = number_or_nan(c, "w"), h = number_or_nan(c, "h");
-    if (fx > 0 && fy > 0 && cx > 0 && cy > 0 && w >= 1 && h >= 1) {
+    /* an export renders previews with this camera: keep it to a sane size */
+    if (fx > 0 && fy > 0 && cx > 0 && cy > 0 && fx < 1e6 && fy < 1e6 && cx < 1e5 && cy < 1e5 &&
+        w >= 1 && h >= 1 && w <= 8192 && h <= 8192) {
         a->has_camera = 1;
         a->camera = (vf_camera){.width = (int)w, .height = (int)h, .fx = fx, .fy = fy, .cx = cx,
                                 .cy = cy};
     }
+}
+
+/* "measure_ranges", or the paper's full ranges for files written before it existed. */
+static vf_status read_ranges(const json_t *doc, const char *path, vf_attack_file *a)
+{
+    const json_t *r = json_object_get(doc, "measure_ranges");
+    if (!r) {
+        vf_view_ranges_paper(a->range);
+        return VF_OK;
+    }
+    if (!read_six(r, a->range))
+        return vf_fail(VF_EINPUT, "%s: \"measure_ranges\" must be 6 numbers", path);
+    for (int i = 0; i < 6; i++)
+        if (!(a->range[i] > 0) || !isfinite(a->range[i]))
+            return vf_fail(VF_EINPUT, "%s: \"measure_ranges\" must be positive", path);
+    return VF_OK;
 }
 
 static vf_status read_samples(const json_t *doc, const char *path, vf_attack_file *a)
@@ -115,6 +136,8 @@ vf_status vf_attack_file_load(const char *path, vf_attack_file *out)
         if (!(out->hi[i] > out->lo[i]))
             status = vf_fail(VF_EINPUT, "%s: bounds hi[%d] must exceed lo[%d]", path, i, i);
     if (status == VF_OK)
+        status = read_ranges(doc, path, out);
+    if (status == VF_OK)
         status = read_labels(doc, path, out);
     if (status == VF_OK)
         status = read_samples(doc, path, out);
@@ -151,6 +174,27 @@ int vf_attack_is_label(const vf_attack_file *a, int cls)
         if (a->labels[i] == cls)
             return 1;
     return 0;
+}
+
+/* ---- targets.json ---- */
+
+vf_status vf_targets_file_target(const char *path, int n, vf_viewpoint *v)
+{
+    json_t *doc;
+    vf_status status = vf_json_load(path, &doc);
+    if (status != VF_OK)
+        return status;
+    const json_t *targets = json_object_get(doc, "targets");
+    size_t count = json_array_size(targets);
+    double a[6];
+    int ok = n >= 0 && (size_t)n < count &&
+             read_six(json_object_get(json_array_get(targets, (size_t)n), "viewpoint"), a);
+    json_decref(doc);
+    if (!ok)
+        return vf_fail(VF_EINPUT, "%s has no usable target %d (it lists %zu, from 0)", path, n,
+                       count);
+    *v = vf_viewpoint_from_array(a);
+    return VF_OK;
 }
 
 /* ---- words ---- */
@@ -213,54 +257,56 @@ void vf_target_describe(const double c2w[16], vf_target_words *out)
 
 /* ---- spreading samples ---- */
 
-static double view_distance(const double *a, const double *b, const double lo[6],
-                            const double hi[6])
+static double view_distance(const double *a, const double *b, const double range[6])
 {
     double s = 0;
     for (int i = 0; i < 6; i++) {
         double d = a[i] - b[i];
         if (i == 0)
             d = remainder(d, 360.0);
-        d /= hi[i] - lo[i];
+        d /= range[i];
         s += d * d;
     }
     return sqrt(s);
 }
 
-void vf_targets_spread(const double *views, int n, const double lo[6], const double hi[6], int m,
-                       int *picked)
+vf_status vf_targets_spread(const double *views, int n, const double range[6], int m,
+                            int *picked)
 {
     if (m > n)
         m = n;
     if (m <= 0)
-        return;
+        return VF_OK;
     double *nearest = malloc(sizeof(double) * (size_t)n);
+    if (!nearest)
+        return vf_fail(VF_EINTERNAL, "out of memory spreading %d viewpoints", n);
     int medoid = 0;
     double best = INFINITY;
     for (int i = 0; i < n; i++) {
         double sum = 0;
         for (int j = 0; j < n; j++)
-            sum += view_distance(views + 6 * i, views + 6 * j, lo, hi);
+            sum += view_distance(views + 6 * i, views + 6 * j, range);
         if (sum < best) {
             best = sum;
             medoid = i;
         }
     }
     picked[0] = medoid;
-    for (int i = 0; nearest && i < n; i++)
-        nearest[i] = view_distance(views + 6 * i, views + 6 * medoid, lo, hi);
+    for (int i = 0; i < n; i++)
+        nearest[i] = view_distance(views + 6 * i, views + 6 * medoid, range);
     for (int k = 1; k < m; k++) {
         int far = 0;
-        for (int i = 1; nearest && i < n; i++)
+        for (int i = 1; i < n; i++)
             if (nearest[i] > nearest[far])
                 far = i;
         picked[k] = far;
-        for (int i = 0; nearest && i < n; i++) {
-            double d = view_distance(views + 6 * i, views + 6 * far, lo, hi);
+        for (int i = 0; i < n; i++) {
+            double d = view_distance(views + 6 * i, views + 6 * far, range);
             nearest[i] = d < nearest[i] ? d : nearest[i];
         }
     }
     free(nearest);
+    return VF_OK;
 }
 
 /* ---- guidance ---- */

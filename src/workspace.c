@@ -14,7 +14,7 @@
 
 vf_status vf_json_save(const char *path, const json_t *doc)
 {
-    char *text = json_dumps(doc, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(12));
+    char *text = json_dumps(doc, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
     if (!text)
         return vf_fail(VF_EINTERNAL, "cannot encode JSON for %s", path);
     size_t len = strlen(text);
@@ -179,14 +179,19 @@ vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary)
     if (status != VF_OK)
         goto fail;
 
-    /* Swap: final -> old, partial -> final, then drop old. */
-    if (vf_is_dir(final_dir) && rename(final_dir, old_dir) != 0) {
+    /* Swap: final -> old, partial -> final, then drop old. On any failure the staging folder
+     * keeps the new output (a stage that resumes finds it again) and the old output goes
+     * back where it was. */
+    int had_final = vf_is_dir(final_dir);
+    if (had_final && rename(final_dir, old_dir) != 0) {
         status = vf_fail(VF_EINTERNAL, "cannot replace %s: %s", final_dir, strerror(errno));
         goto fail;
     }
     if (rename(s->dir, final_dir) != 0) {
         status = vf_fail(VF_EINTERNAL, "cannot move %s into place: %s", s->dir, strerror(errno));
-        rename(old_dir, final_dir);
+        if (had_final && rename(old_dir, final_dir) != 0)
+            status = vf_fail(VF_EINTERNAL, "%s; the previous output is in %s", vf_error_message(),
+                             old_dir);
         goto fail;
     }
 
@@ -201,13 +206,18 @@ vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary)
     json_object_set_new(stages, s->name, record);
     status = vf_json_save(manifest_path, ws->manifest);
     if (status != VF_OK) {
-        /* The manifest must describe what is on disk: put the old folder and record back. */
-        vf_remove_tree(final_dir);
-        rename(old_dir, final_dir);
+        /* The manifest must describe what is on disk: the new output back to staging, the old
+         * folder and record back in place. */
         if (previous)
             json_object_set(stages, s->name, previous);
         else
             json_object_del(stages, s->name);
+        if (rename(final_dir, s->dir) != 0)
+            status = vf_fail(VF_EINTERNAL, "%s; the new output stays in %s", vf_error_message(),
+                             final_dir);
+        else if (had_final && rename(old_dir, final_dir) != 0)
+            status = vf_fail(VF_EINTERNAL, "%s; the previous output is in %s", vf_error_message(),
+                             old_dir);
     } else {
         vf_remove_tree(old_dir);
     }
@@ -217,7 +227,6 @@ vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary)
 fail:
     json_decref(params);
     json_decref(summary);
-    vf_stage_abort(s);
     return status;
 }
 

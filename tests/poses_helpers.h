@@ -124,4 +124,23 @@ static inline pose_errors compare_poses(const double *const *ours, const double 
     return e;
 }
 
+/* compare_poses, printed and checked against limits (degrees; shares of the distance). */
+typedef struct pose_limits {
+    double rot_median, rot_p90, pos_median, pos_p90;
+} pose_limits;
+
+static inline pose_errors check_poses(const double *const *ours, const double *const *ref, int n,
+                                      pose_limits limit)
+{
+    pose_errors e = compare_poses(ours, ref, n, VF_CAMERA_DISTANCE);
+    printf("rotation error: median %.3f deg, p90 %.3f deg; position error: median %.3f%%, "
+           "p90 %.3f%% of the camera distance\n",
+           e.rot_median, e.rot_p90, 100 * e.pos_median, 100 * e.pos_p90);
+    CHECK(e.rot_median < limit.rot_median, "rotation error median %.3f deg", e.rot_median);
+    CHECK(e.rot_p90 < limit.rot_p90, "rotation error p90 %.3f deg", e.rot_p90);
+    CHECK(e.pos_median < limit.pos_median, "position error median %.4f", e.pos_median);
+    CHECK(e.pos_p90 < limit.pos_p90, "position error p90 %.4f", e.pos_p90);
+    return e;
+}
+
 #endif

@@ -1,7 +1,11 @@
 /* Tests of vf/camera.h: intrinsics, OPENCV distortion and its inverse, projection, pixel rays. */
+#include <string.h>
+
 #include "check.h"
 
+#include "vf/calib.h"
 #include "vf/camera.h"
+#include "vf/fsutil.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -150,8 +154,39 @@ static void test_pixel_ray(void)
         }
 }
 
+/* The camera file (calib/camera_file.c): both spellings of the keys, and every hostile value
+ * refused with a message naming the key. */
+static void test_camera_file(void)
+{
+    char path[VF_PATH_MAX];
+    vf_path_join(path, sizeof path, vf_test_tmpdir(), "camera.json");
+    const char *good = "{\"fx\": 500, \"fy\": 501, \"cx\": 320, \"cy\": 240, \"width\": 640, "
+                       "\"height\": 480, \"k1\": 0.1}";
+    vf_camera cam;
+    vf_write_file_atomic(path, good, strlen(good));
+    CHECK(vf_calib_load_camera(path, &cam) == VF_OK && cam.width == 640 && cam.fy == 501 &&
+              cam.k1 == 0.1 && cam.p2 == 0,
+          "fx/width spelling: %s", vf_error_message());
+    static const char *const bad[][2] = {
+        {"{\"fl_x\": 500, \"fl_y\": 500, \"cx\": 320, \"cy\": 240, \"w\": 1e300, \"h\": 480}", "\"w\""},
+        {"{\"fl_x\": 500, \"fl_y\": 500, \"cx\": 320, \"cy\": 240, \"w\": 640.5, \"h\": 480}", "\"w\""},
+        {"{\"fl_x\": -1, \"fl_y\": 500, \"cx\": 320, \"cy\": 240, \"w\": 640, \"h\": 480}", "fl_x"},
+        {"{\"fl_x\": 500, \"fl_y\": 500, \"cx\": 320, \"w\": 640, \"h\": 480}", "cy"},
+        {"{\"fl_x\": 500, \"fl_y\": 500, \"cx\": 320, \"cy\": 240, \"w\": 640, \"h\": 480, "
+         "\"k2\": 1e50}", "k2"},
+        {"[1, 2, 3]", "not a camera file"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        vf_write_file_atomic(path, bad[i][0], strlen(bad[i][0]));
+        CHECK(vf_calib_load_camera(path, &cam) == VF_EINPUT &&
+                  strstr(vf_error_message(), bad[i][1]),
+              "case %zu refused naming %s: %s", i, bad[i][1], vf_error_message());
+    }
+}
+
 int main(void)
 {
+    test_camera_file();
     test_intrinsics();
     test_distort_hand_worked();
     test_undistort();

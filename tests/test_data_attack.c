@@ -3,6 +3,7 @@
  * ImageNet has. Asserts that the classifier recognises the chair at natural views, that the
  * attack's distribution fools it far more often than the random-search baseline over the same
  * box, and that v* is misclassified. About 2 minutes on 2 cores. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -115,7 +116,7 @@ int main(void)
     vf_view_prediction star, pred[VF_EVAL_SAMPLES];
     vf_rng rng;
     vf_rng_seed(&rng, 11);
-    vf_attack_best_view(&st, &cfg, v_star);
+    vf_attack_v_star(&st, &cfg, v_star);
     vf_attack_sample_views(&st, &cfg, &rng, VF_EVAL_SAMPLES, samples);
     CHECK(vf_view_loss_classify(vl, v_star, 1, &star, NULL) == VF_OK &&
               vf_view_loss_classify(vl, samples, VF_EVAL_SAMPLES, pred, NULL) == VF_OK,
@@ -138,10 +139,14 @@ int main(void)
           "15 points", 100 * asr, 100 * random.asr);
     CHECK(!star.correct, "v* is classified as '%s', inside the label set",
           vf_class_short_name(star.top_class));
-    /* The optimizer really moved: the loss climbed over the run. */
-    CHECK(st.history[st.step - 1].mean_loss > st.history[0].mean_loss,
-          "mean loss %.3f at the last step, %.3f at the first", st.history[st.step - 1].mean_loss,
-          st.history[0].mean_loss);
+    /* The optimizer really moved the distribution from where it started (the box centre, a
+     * view from straight above that already fools the classifier, so the mean loss itself
+     * need not rise while the entropy term widens p*(v)). */
+    double moved = 0;
+    for (int i = 0; i < VF_VIEW_DIM; i++)
+        moved = fmax(moved, fabs(v_star[i] - 0.5 * (cfg.bounds.lo[i] + cfg.bounds.hi[i])) /
+                                (cfg.bounds.hi[i] - cfg.bounds.lo[i]));
+    CHECK(moved > 0.02, "v* moved %.1f%% of a range from the start", 100 * moved);
 
     vf_attack_state_free(&st);
     vf_view_loss_free(vl);

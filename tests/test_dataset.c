@@ -95,5 +95,31 @@ int main(void)
                     &ds) == VF_EINPUT,
           "missing image");
     CHECK(strstr(vf_error_message(), "nope/r_0") != NULL, "message: %s", vf_error_message());
+
+    /* Numbers out of range are refused, never cast (fuzzing: "w": 1e300 was undefined
+     * behaviour in the int conversion; a huge matrix entry renders from infinity). */
+    static const char *const hostile[][2] = {
+        {"\"w\": 1e300, \"h\": 200", "w and h"},
+        {"\"w\": -5, \"h\": 200", "w and h"},
+        {"\"w\": 200.5, \"h\": 200", "w and h"},
+        {"\"fl_x\": 1e200", "out of range"},
+        {"\"k1\": 1e9", "out of range"},
+    };
+    for (size_t i = 0; i < sizeof hostile / sizeof hostile[0]; i++) {
+        snprintf(json, sizeof json,
+                 "{\"camera_angle_x\": 0.69, %s, \"frames\": [{\"file_path\": \"%s\", "
+                 "\"transform_matrix\": [[1,0,0,0],[0,1,0,0],[0,0,1,4],[0,0,0,1]]}]}",
+                 hostile[i][0], vf_test_shared("data/nerf_synthetic/chair/train/r_0"));
+        CHECK(load_text("hostile.json", json, &ds) == VF_EINPUT &&
+                  strstr(vf_error_message(), hostile[i][1]),
+              "%s refused: %s", hostile[i][0], vf_error_message());
+    }
+    snprintf(json, sizeof json,
+             "{\"camera_angle_x\": 0.69, \"frames\": [{\"file_path\": \"%s\", "
+             "\"transform_matrix\": [[1,0,0,0],[0,1,0,0],[0,0,1,1e300],[0,0,0,1]]}]}",
+             vf_test_shared("data/nerf_synthetic/chair/train/r_0"));
+    CHECK(load_text("hostile.json", json, &ds) == VF_EINPUT &&
+              strstr(vf_error_message(), "transform_matrix[2][3]"),
+          "a huge matrix entry refused: %s", vf_error_message());
     return check_finish();
 }

@@ -11,6 +11,8 @@
 #include "../src/field/trainer_internal.h"
 #include "vf/error.h"
 #include "vf/field.h"
+#include "vf/fsutil.h"
+#include "vf/log.h"
 #include "vf/pose.h"
 
 static uint64_t rng_state = 0x2545f4914f6cdd1dull;
@@ -357,6 +359,120 @@ static void test_model_files(void)
     vf_field_free(f);
 }
 
+/* A model file crafted from make_field with one thing broken must be refused with a message
+ * naming the file, quickly and without taking the memory its header claims (fuzzing found
+ * each of these crashing or hanging the renderer, or exhausting the machine). */
+static void check_refused(vf_field *f, const char *why, const char *path)
+{
+    CHECK(vf_field_save(f, path) == VF_OK, "%s: save", why);
+    vf_field *loaded = NULL;
+    double t0 = vf_now();
+    vf_status s = vf_field_load(path, &loaded);
+    CHECK(s == VF_EINPUT && !loaded && strstr(vf_error_message(), path),
+          "%s: refused (%s)", why, vf_error_message());
+    CHECK(vf_now() - t0 < 2.0, "%s: refused in %.1f s", why, vf_now() - t0);
+    vf_field_free(loaded);
+    vf_field_free(f);
+}
+
+/* The offset of the first grid's dims (three int32 12s) in a saved make_field model. */
+static long find_dims(const char *path)
+{
+    char *data;
+    size_t size;
+    long at = -1;
+    const int32_t dims[3] = {12, 12, 12};
+    if (vf_read_file(path, &data, &size) != VF_OK)
+        return -1;
+    for (size_t i = 16; at < 0 && i + sizeof dims <= size && i < 400; i += 4)
+        if (!memcmp(data + i, dims, sizeof dims))
+            at = (long)i;
+    free(data);
+    return at;
+}
+
+static void test_hostile_models(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/hostile.vff", vf_test_tmpdir());
+    vf_field *f = make_field();
+    f->grids[0].values[5 * FIELD_CH + FIELD_CH_DENSITY] = NAN;
+    check_refused(f, "a NaN density", path);
+    f = make_field();
+    f->grids[0].values[77 * FIELD_CH + FIELD_CH_SH + 3] = INFINITY;
+    check_refused(f, "an infinite colour", path);
+    f = make_field();
+    f->grids[0].lo[1] = NAN;
+    check_refused(f, "a NaN box", path);
+    f = make_field();
+    f->density_shift = 1e30f;
+    check_refused(f, "an extreme density shift", path);
+    f = make_field();
+    f->step_ratio = 1e-9f;
+    check_refused(f, "a tiny step ratio", path);
+    f = make_field();
+    f->grids[0].voxel = 0;
+    check_refused(f, "a zero voxel", path);
+
+    /* a header claiming a 4000^3 grid in a 100 KB file: refused before allocating */
+    f = make_field();
+    CHECK(vf_field_save(f, path) == VF_OK, "save");
+    vf_field_free(f);
+    long at = find_dims(path);
+    const int32_t huge[3] = {4000, 4000, 4000};
+    CHECK(at > 0 && patch_file(path, at, huge, sizeof huge) == 0, "dims at %ld patched", at);
+    vf_field *loaded = NULL;
+    CHECK(vf_field_load(path, &loaded) == VF_EINPUT && !loaded &&
+              strstr(vf_error_message(), "claims"),
+          "huge grid claim refused: %s", vf_error_message());
+
+    /* the renderer's opacity table takes any density, NaN included, without reading outside */
+    f = make_field();
+    field_render_setup setup;
+    field_render_setup_init(f, &setup);
+    const field_render_grid *r = &setup.grids[0];
+    const float odd[5] = {NAN, INFINITY, -INFINITY, 3e38f, -3e38f};
+    for (int i = 0; i < 5; i++) {
+        float a = field_render_alpha(r, odd[i]);
+        CHECK(a >= 0.0f && a <= 1.0f, "alpha of %g is %g", (double)odd[i], (double)a);
+    }
+    vf_field_free(f);
+}
+
+/* Every thread's gradient sink is applied even when OpenMP gives the optimizer a smaller
+ * team than the trainer's thread count (here: a nested region, which runs on one thread;
+ * OMP_DYNAMIC can do the same). Once, sink 1 was then silently dropped. */
+static void touch(field_grad_sink *s, size_t i, float g)
+{
+    s->grad[0][i * FIELD_CH + FIELD_CH_DENSITY] = g;
+    s->touched[0][i] = 1;
+    s->list[0][s->count[0]++] = (uint32_t)i;
+}
+
+static void test_adam_small_team(void)
+{
+    vf_field *f = make_field();
+    field_adam adam = {0};
+    CHECK(field_adam_alloc(&adam, f, 2) == VF_OK, "adam for 2 threads");
+    float lr[FIELD_CH];
+    for (int ch = 0; ch < FIELD_CH; ch++)
+        lr[ch] = 0.1f;
+    const size_t a = 10, b = 500;
+    const float before_a = f->grids[0].values[a * FIELD_CH], before_b = f->grids[0].values[b * FIELD_CH];
+    touch(&adam.sinks[0], a, 1.0f);
+    touch(&adam.sinks[1], b, 1.0f);
+#pragma omp parallel num_threads(2)
+    {
+#pragma omp single
+        field_adam_step(&adam, f, lr, 0, 0); /* nested: a team of one */
+    }
+    CHECK(f->grids[0].values[a * FIELD_CH] < before_a - 0.05f, "sink 0 applied");
+    CHECK(f->grids[0].values[b * FIELD_CH] < before_b - 0.05f, "sink 1 applied by a team of one");
+    CHECK(field_adam_touched(&adam) == 0, "sinks cleared");
+    field_adam_free(&adam);
+    vf_field_free(f);
+}
+
 /* Training views: renders of the synthetic field from a ring of cameras. */
 static void add_views(vf_field_trainer *t, const vf_field *f, int count)
 {
@@ -420,6 +536,15 @@ static void test_checkpoint_resume(void)
     add_views(other, truth, 11);
     CHECK(vf_field_trainer_resume(other, ckpt) == VF_EINPUT, "checkpoint of other views refused");
     vf_field_trainer_free(other);
+
+    /* another budget: refused with a message, not silently replaced by the old one */
+    opt.steps = 80;
+    vf_field_trainer_create(&opt, &other);
+    add_views(other, truth, 12);
+    CHECK(vf_field_trainer_resume(other, ckpt) == VF_EINPUT &&
+              strstr(vf_error_message(), "budget of 40 steps"),
+          "a new budget on resume refused: %s", vf_error_message());
+    vf_field_trainer_free(other);
     vf_field_trainer_free(r);
     vf_field_trainer_free(t);
     vf_field_free(truth);
@@ -470,6 +595,8 @@ int main(void)
     test_render_matches_march();
     test_jumps_skip_only_empty();
     test_model_files();
+    test_hostile_models();
+    test_adam_small_team();
     test_checkpoint_resume();
     return check_finish();
 }

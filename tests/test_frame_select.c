@@ -150,6 +150,31 @@ static void test_selection(void)
     free(s);
 }
 
+/* Photos have no capture order: a few plain photos among detailed ones (neighbours in name
+ * order) are not blurry, only one far below the median of them all is. */
+static void test_unordered(void)
+{
+    vf_select_params p;
+    vf_select_defaults(&p);
+    vf_frame_score *s = scores_for(30);
+    s[14].sharpness = s[15].sharpness = 30; /* plain but sharp views */
+    s[22].sharpness = 10;                    /* truly blurry */
+    vf_selection sel;
+    CHECK(vf_select_frames(s, 30, &p, &sel) == VF_OK, "%s", vf_error_message());
+    CHECK(sel.verdict[14] == VF_FRAME_BLURRY && sel.verdict[22] == VF_FRAME_BLURRY,
+          "video rule: both below 0.4 x the local median");
+    vf_selection_free(&sel);
+    p.unordered = 1;
+    p.blur_ratio = 0.2; /* the photo default (vf_ingest_defaults) */
+    CHECK(vf_select_frames(s, 30, &p, &sel) == VF_OK, "%s", vf_error_message());
+    CHECK(sel.verdict[14] != VF_FRAME_BLURRY && sel.verdict[15] != VF_FRAME_BLURRY &&
+              sel.verdict[22] == VF_FRAME_BLURRY,
+          "photo rule: only the one under 0.2 x the median of all");
+    CHECK(sel.chosen_count == 29, "29 of 30 photos kept, got %d", sel.chosen_count);
+    vf_selection_free(&sel);
+    free(s);
+}
+
 static void test_live_counter(void)
 {
     vf_select_params p;
@@ -170,6 +195,7 @@ int main(void)
 {
     test_sharpness();
     test_selection();
+    test_unordered();
     test_live_counter();
     return check_finish();
 }

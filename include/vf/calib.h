@@ -139,6 +139,12 @@ vf_status vf_calib_solve(vf_calib_views *set, const vf_calib_board *board,
 vf_status vf_calib_save_camera(const char *path, const vf_calib_result *res,
                                const vf_calib_views *set, const vf_calib_board *board);
 
+/* Read a camera file (the one module that does): fl_x (or fx), fl_y (or fy), cx, cy, w (or
+ * width), h (or height) in pixels, and k1, k2, p1, p2 when present (else 0). VF_EINPUT naming
+ * the file and the key when a value is missing or out of range (focal lengths and the
+ * principal point in (0, 1e6), w and h whole numbers 1 to 100000, distortion |k| <= 100). */
+vf_status vf_calib_load_camera(const char *path, vf_camera *cam);
+
 /* ---- geometry shared by the calibration and its tests ---- */
 
 /* Render a textured plane through a lens: the texture lies on the plane z = 0 of its own

@@ -53,8 +53,17 @@ vf_status vf_classifier_preprocess(const vf_image *rgb, int size, float *chw_out
  * with the ImageNet mean/std, writing 3 * width * height floats in CHW order. */
 vf_status vf_classifier_normalize(const vf_image *rgb, float *chw_out);
 
-/* Run n preprocessed inputs (n * 3 * S * S floats, NCHW) and write n * VF_NUM_CLASSES softmax
- * probabilities to probs_out. */
+/* Run n preprocessed inputs (n * 3 * S * S floats, NCHW) and write the model's n *
+ * VF_NUM_CLASSES logits to logits_out. */
+vf_status vf_classifier_logits(vf_classifier *cls, const float *batch_nchw, int n,
+                               float *logits_out);
+
+/* The cross-entropy of a label set from one image's logits z, in double precision:
+ *     -log sum_{y in set} softmax(z)_y = logsumexp(z) - logsumexp(z over the set),
+ * finite and informative however confident the model is (no probability floor). */
+double vf_label_set_cross_entropy(const float *logits, const int *labels, int count);
+
+/* As vf_classifier_logits, then a softmax: n * VF_NUM_CLASSES probabilities in probs_out. */
 vf_status vf_classifier_forward(vf_classifier *cls, const float *batch_nchw, int n,
                                 float *probs_out);
 

@@ -69,23 +69,13 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
 vf_status vf_field_render_viewpoints(const vf_field *f, const vf_camera *cam,
                                      const vf_viewpoint *viewpoints, int n, vf_image *out);
 
-/* Render the expected ray depth (world units along the ray; 0 where nothing was hit) and
- * the accumulated opacity into two 1-channel images (either may be NULL). Allocation as in
- * vf_field_render. */
-vf_status vf_field_render_depth(const vf_field *f, const vf_camera *cam, const double c2w[16],
-                                vf_image *depth, vf_image *opacity);
-
 /* The pinhole camera whose size x size image equals what a classifier sees of a training
  * photo: the photo resized so its shorter side is size * 256 / 224, then centre-cropped to
  * size x size (vf_classifier_preprocess). Lens distortion is dropped. */
 vf_camera vf_field_classifier_camera(const vf_field *f, int size);
 
-/* A reference training camera (intrinsics of the first view the field was trained on). */
-vf_camera vf_field_training_camera(const vf_field *f);
-
 /* The colour of rays that see nothing (white for objects on transparent backgrounds). */
 void vf_field_background(const vf_field *f, float rgb[3]);
-void vf_field_set_background(vf_field *f, const float rgb[3]);
 
 /* Facts about a field, for reports. */
 typedef struct vf_field_info {

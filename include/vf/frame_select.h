@@ -4,7 +4,8 @@
  *   1. a frame much blurrier than its neighbours (sharpness below blur_ratio times the median
  *      of the frames within blur_window of it) is rejected as blurry: motion blur and focus
  *      hunting come and go within a second, while the scene's own amount of detail changes
- *      slowly, so only the local median is a fair yardstick;
+ *      slowly, so only the local median is a fair yardstick (frames without an order, such
+ *      as a folder of photos, are compared with the median of them all);
  *   2. the capture is cut into min(max_frames, count) stretches of equal length, and each
  *      stretch gives its sharpest frame that is not blurry and not a near-duplicate of the
  *      frame chosen before it (thumbnails closer than duplicate_threshold: the camera stood
@@ -27,6 +28,8 @@ typedef struct vf_select_params {
     int max_frames;             /* keep at most this many (default 100) */
     double blur_ratio;          /* blurry below this times the local median (default 0.4) */
     int blur_window;            /* neighbours on each side for the local median (default 7) */
+    int unordered;              /* frames not in capture order (photos): compare each with the
+                                   median of all frames, not of its neighbours (default 0) */
     double duplicate_threshold; /* thumbnail difference below which frames repeat (default 1.5) */
 } vf_select_params;
 

@@ -27,6 +27,10 @@ extern "C" {
 typedef struct vf_ingest_options {
     vf_select_params select;   /* how many frames to keep, blur and duplicate rules */
     int max_size;              /* longer side of the written frames (default 1024) */
+    /* Photos only: a photo is blurry below this times the median sharpness of all the photos
+     * (default 0.2: only the truly unusable; a person expects the photos they took used, and
+     * a folder has no capture order, so there are no neighbours to compare with). */
+    double photo_blur_ratio;
     /* Webcam only: */
     double seconds;            /* how long to capture (default 10) */
     int width, height;         /* requested frame size (default 1280 x 720; the driver may
@@ -39,14 +43,20 @@ typedef struct vf_ingest_options {
 /* The defaults above. */
 void vf_ingest_defaults(vf_ingest_options *options);
 
+/* What a workspace's frames came from, as its ingest report says: "video", "photos",
+ * "camera", "transforms", or "" when the report does not say (frames put there by hand).
+ * Frames of a video or a webcam are in capture order; photos and unknown frames are not. */
+void vf_ingest_source_kind(const char *ws_root, char *kind, size_t size);
+
 /* A video file FFmpeg decodes (two passes: score every frame, then decode again and write the
  * chosen ones). Errors name the file: not a video, no frames, no usable frame. */
 vf_status vf_ingest_video(const char *path, const vf_ingest_options *options, const char *out_dir,
                           json_t **report);
 
 /* A folder of photos (.jpg, .jpeg, .png, in name order; alpha composited onto white). All are
- * kept unless blurry or duplicates (at most select.max_frames, spread over the set); the
- * report counts portrait and landscape photos and warns when they are mixed. */
+ * kept unless blurry (photo_blur_ratio) or duplicates (at most select.max_frames, spread over
+ * the set); the report names each dropped photo with its reason and counts portrait and
+ * landscape photos. */
 vf_status vf_ingest_photos(const char *folder, const vf_ingest_options *options,
                            const char *out_dir, json_t **report);
 

@@ -14,7 +14,6 @@ extern "C" {
 #endif
 
 void vf_log_set_quiet(int quiet);
-int vf_log_is_quiet(void);
 
 void vf_info(const char *fmt, ...)
 #ifdef __GNUC__

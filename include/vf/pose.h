@@ -142,10 +142,6 @@ void vf_viewpoint_to_c2w(const vf_viewpoint *v, double c2w[16]);
  * (-180, 180] (so psi = -180 returns as 180) and phi in (-90, 270]. */
 void vf_c2w_to_viewpoint(const double c2w[16], vf_viewpoint *out);
 
-/* The default search box from DESIGN.md: psi [-180, 180], theta [-30, 30], phi [20, 160],
- * dx [-0.5, 0.5], dy [-1, 1], dz [-0.5, 0.5]. */
-void vf_viewpoint_bounds(double lo[VF_VIEWPOINT_DIMS], double hi[VF_VIEWPOINT_DIMS]);
-
 void vf_viewpoint_to_array(const vf_viewpoint *v, double a[VF_VIEWPOINT_DIMS]);
 vf_viewpoint vf_viewpoint_from_array(const double a[VF_VIEWPOINT_DIMS]);
 

@@ -21,6 +21,7 @@
 #include "vf/error.h"
 #include "vf/fsutil.h"
 #include "vf/pose.h"
+#include "vf/viewfool.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -42,7 +43,9 @@ typedef struct vf_attack_file {
     int label_count;
     int labels[VF_MAX_LABELS];      /* the true label set */
     char label_text[256];           /* its names, comma-separated */
-    double lo[6], hi[6];            /* viewpoint bounds */
+    double lo[6], hi[6];            /* the attack's search box */
+    double range[6];                /* measurement ranges ("measure_ranges"; the paper's full
+                                     * ranges when absent): tolerances are shares of these */
     vf_viewpoint v_star;
     int sample_count;
     double *samples;                /* sample_count x 6: the samples of p*(v) */
@@ -57,6 +60,10 @@ typedef struct vf_attack_file {
  * "label") when it cannot be used; samples, predictions, rates and camera are optional. */
 vf_status vf_attack_file_load(const char *path, vf_attack_file *out);
 void vf_attack_file_free(vf_attack_file *a);
+
+/* The viewpoint of target n (from 0) of an export's targets.json. VF_EINPUT naming the file
+ * when there is no such target or its six numbers are not finite and in range. */
+vf_status vf_targets_file_target(const char *path, int n, vf_viewpoint *v);
 
 /* Whether class `cls` belongs to the attack's label set. */
 int vf_attack_is_label(const vf_attack_file *a, int cls);
@@ -79,10 +86,11 @@ void vf_target_describe(const double c2w_object[16], vf_target_words *out);
 /* ---- choosing representative samples ---- */
 
 /* Pick m of the n viewpoints (n x 6) spread over the set: first the medoid, then each time
- * the viewpoint farthest from all picked ones (distances per parameter as shares of the
- * bounds' range, psi wrapping around). Writes m indices (m <= n) to picked. */
-void vf_targets_spread(const double *views, int n, const double lo[6], const double hi[6], int m,
-                       int *picked);
+ * the viewpoint farthest from all picked ones (distances per parameter as shares of range[i],
+ * the measurement ranges, psi wrapping around). Writes min(m, n) indices to picked;
+ * VF_EINTERNAL when out of memory. */
+vf_status vf_targets_spread(const double *views, int n, const double range[6], int m,
+                            int *picked);
 
 /* ---- guidance ---- */
 

@@ -4,9 +4,13 @@
  * poses) of a field with the classifier camera (the S x S crop a classifier sees of a training
  * photo, vf_field_classifier_camera), normalize, classify the batch, and score it against a
  * true label set. Everything stays in memory: no files in the loop. The loss of a view is
- * the cross-entropy of the label set,
+ * the cross-entropy of the label set, from the logits z in double precision
+ * (vf_label_set_cross_entropy),
  *
- *     L(v) = -log( sum over y in the set of p_y(R(v)) ),
+ *     L(v) = -log( sum over y in the set of p_y(R(v)) ) = logsumexp(z) - logsumexp(z_set),
+ *
+ * so confidently correct views still differ in loss (and give a search gradient) and fooled
+ * views do not saturate.
  *
  * and the view fools the classifier when its top-1 class is outside the set. Rendering and
  * classification use every core; buffers are allocated once, for VF_VIEW_LOSS_CHUNK views,
@@ -32,12 +36,11 @@ extern "C" {
 
 #define VF_VIEW_LOSS_CHUNK 16   /* views rendered and classified together */
 #define VF_MAX_LABELS 32        /* classes in one label set */
-#define VF_VIEW_LOSS_FLOOR 1e-30 /* label-set probability floor: losses stay finite (<= 69) */
 
 typedef struct vf_view_prediction {
     int top_class;    /* top-1 ImageNet class */
     float top_prob;   /* its probability */
-    float label_prob; /* total probability of the label set (0 before labels are set) */
+    float label_prob; /* total probability of the label set, exp(-loss) (0 before labels are set) */
     int correct;      /* top_class is in the label set */
 } vf_view_prediction;
 
@@ -71,9 +74,6 @@ vf_status vf_view_loss_classify_poses(vf_view_loss *vl, const double *c2w, int n
 /* The attack's loss callback (vf/viewfool.h, vf_attack_loss_fn); ctx is a vf_view_loss with
  * its labels set. */
 vf_status vf_view_loss_fn(const double *views, int n, double *losses, int *fooled, void *ctx);
-
-/* -log(max(label_prob, VF_VIEW_LOSS_FLOOR)). */
-double vf_view_loss_of(double label_prob);
 
 /* Render one viewpoint with the classifier camera into out (allocated as vf_field_render). */
 vf_status vf_view_loss_render(const vf_view_loss *vl, const double view[6], vf_image *out);

@@ -14,13 +14,20 @@
  * caller supplies L as a batch callback (render k viewpoints, classify, return k losses), so
  * this module never touches images. Two optimizers:
  *
- *   VF_ATTACK_NES   the paper's Eq. 7: score-function (NES) gradient of E[L] with a mean-loss
- *                   baseline, by default preconditioned by the inverse Fisher (natural
- *                   gradient), plus the exact gradient of the entropy; Adam ascent on
- *                   (mu, log sigma, mixture logits). Formulas: src/viewfool/nes.c.
- *   VF_ATTACK_PEPG  the reference code's variant: PEPG with antithetic pairs, centred-rank
- *                   fitness shaping, momentum SGD on mu, lambda = 0; v* is the best sample of
- *                   the last step.
+ *   VF_ATTACK_NES   the paper's Eq. 7 in (mu, sigma): the score-function (NES) gradient of
+ *                   E[L] with a mean-loss baseline, preconditioned by the inverse Fisher
+ *                   (natural gradient), plus the plain exact gradient of lambda * H; Adam
+ *                   ascent on mu, sigma (and the mixture logits). The loss term's natural
+ *                   gradient in sigma shrinks like sigma^3 while the entropy's grows like
+ *                   lambda / sigma, so sigma settles where they balance, wider for larger
+ *                   lambda: that balance is what keeps p*(v) a distribution. Formulas:
+ *                   src/viewfool/nes.c.
+ *   VF_ATTACK_PEPG  the reference code's optimizer: PEPG with the mean as sample 0 and
+ *                   antithetic pairs, centred-rank fitness, momentum SGD on mu with a
+ *                   decaying step, sigma clipped to 0.15 (src/viewfool/pepg.c).
+ *
+ * Two answers are reported for every method: v* = a * tanh(mu*) + b (the paper's definition,
+ * vf_attack_v_star) and the best sample of the last step (the reference code's, vf_attack_v_best).
  *
  * The optimizer state is a plain struct (plus one heap array, the per-step history) that
  * serializes to JSON, so an interrupted attack resumes bit-exactly. Memory: the caller owns
@@ -41,7 +48,7 @@ extern "C" {
 
 #define VF_VIEW_DIM 6              /* psi, theta, phi, dx, dy, dz */
 #define VF_ATTACK_MAX_COMPONENTS 8 /* largest mixture K */
-/* Per component: mu[6], log sigma[6], one mixture logit. */
+/* Per component: mu[6], sigma[6], one mixture logit. */
 #define VF_ATTACK_COMPONENT_PARAMS (2 * VF_VIEW_DIM + 1)
 #define VF_ATTACK_MAX_PARAMS (VF_ATTACK_MAX_COMPONENTS * VF_ATTACK_COMPONENT_PARAMS)
 
@@ -58,14 +65,29 @@ void vf_view_bounds_default(vf_view_bounds *bounds);
 /* VF_EINPUT unless every lo < hi and both are finite. */
 vf_status vf_view_bounds_check(const vf_view_bounds *bounds);
 
+/* The paper's full range of each parameter, the widths of the default box: psi 360 deg,
+ * theta 60, phi 140, dx 1, dy 2, dz 1. Camera fluctuation and the re-shoot tolerance are
+ * percentages of these, not of a (narrowed) search box, so figures compare across objects. */
+void vf_view_ranges_paper(double range[VF_VIEW_DIM]);
+
+/* Search spaces of the paper's Table 1: all six parameters, the rotation (psi, theta, phi) with
+ * the offsets fixed, or the translation (dx, dy, dz) with the angles fixed. */
+typedef enum { VF_SPACE_BOTH = 0, VF_SPACE_ROTATION = 1, VF_SPACE_TRANSLATION = 2 } vf_view_space;
+
+/* "both", "rotation", "translation"; VF_EINPUT naming the choices otherwise. */
+vf_status vf_view_space_parse(const char *name, vf_view_space *space);
+const char *vf_view_space_name(vf_view_space space);
+
+/* Fix the parameters outside the space (a box 2e-6 wide) at the values of `at`, clipped into
+ * the box, or at the box's centre when `at` is NULL. Callers pass a natural viewpoint (the
+ * training view the classifier recognises best): the centre of the default box looks
+ * straight down (phi 90), where the translation space would start out misclassified. */
+void vf_view_bounds_restrict(vf_view_bounds *bounds, vf_view_space space,
+                             const double at[VF_VIEW_DIM]);
+
 /* v = a * tanh(u) + b, one viewpoint. */
 void vf_view_squash(const vf_view_bounds *bounds, const double u[VF_VIEW_DIM],
                     double v[VF_VIEW_DIM]);
-
-/* The inverse, u = atanh((v - b) / a), with v pulled 1e-9 of the range inside the box so u
- * stays finite for v on the boundary. */
-void vf_view_unsquash(const vf_view_bounds *bounds, const double v[VF_VIEW_DIM],
-                      double u[VF_VIEW_DIM]);
 
 /* ---- entropy of the squashed Gaussian ---- */
 
@@ -89,39 +111,41 @@ typedef enum { VF_ATTACK_NES = 0, VF_ATTACK_PEPG = 1 } vf_attack_method;
 typedef struct vf_attack_config {
     vf_view_bounds bounds;
     vf_attack_method method;
-    int samples;    /* k, loss evaluations per step (PEPG: k/2 antithetic pairs, k even) */
+    int samples;    /* k, loss evaluations per step (PEPG: the mean and (k-1)/2 antithetic
+                     * pairs, k odd) */
     int steps;      /* vf_attack_run stops when the state reaches this many steps */
-    double lambda;  /* entropy weight (NES 0.01, PEPG 0) */
-    double lr;      /* Adam step (NES, in u units) or SGD step (PEPG) */
+    double lambda;  /* entropy weight */
+    double lr;      /* step of mu: Adam (NES, in u units) or momentum SGD (PEPG) */
     uint64_t seed;  /* seeds the state's RNG at vf_attack_init */
 
-    /* sigma: initial value and the clip range (NES clips log sigma, PEPG clips sigma) */
+    /* sigma (in u units): initial value and the range it is kept in */
     double sigma_init, sigma_min, sigma_max;
+    double sigma_lr; /* NES: Adam step of sigma; PEPG: sigma step (each change clipped to
+                      * +-20% of sigma) */
 
     /* NES only */
-    int natural_gradient; /* 1: multiply by the inverse Fisher; 0: plain score function.
-                           * With lambda = 0 use 0: sigma then shrinks steadily and the
-                           * sigma^2-scaled mean steps stall under Adam. */
     int antithetic;       /* 1: samples come in mirrored pairs eps, -eps */
     int components;       /* K, mixture components in u (1 = the paper's single Gaussian) */
     double weight_lr;     /* K > 1: Adam step of the mixture logits (0 keeps weights equal) */
     double adam_beta1, adam_beta2;
 
     /* PEPG only */
-    double momentum;  /* velocity = momentum * velocity + (1 - momentum) * gradient */
-    double lr_decay;  /* lr at step t is lr * lr_decay^t */
-    double sigma_lr;  /* step of the sigma update (relative change clipped to +-20%) */
+    double momentum;    /* velocity = momentum * velocity + (1 - momentum) * gradient */
+    double lr_decay;    /* lr at step t is lr * lr_decay^t */
+    double sigma_decay; /* after each step, sigma > 0.01 is multiplied by this */
 } vf_attack_config;
 
-/* Defaults for a method: bounds as vf_view_bounds_default, k = 50, 100 steps, seed 0 and
- *   NES:  lambda 0.01, Adam lr 0.1 (beta 0.9, 0.999), sigma 0.1 in [1e-3, 2], natural
- *         gradient, antithetic sampling, K = 1 (mixture logits' Adam step 0.01);
- *   PEPG: lambda 0, lr 0.1, momentum 0.9, lr_decay 0.99, sigma 0.1 in [1e-3, 0.15],
- *         sigma_lr 0.2. */
+/* Defaults for a method: bounds as vf_view_bounds_default, 100 steps, seed 0, lambda 0.01 and
+ *   NES:  k = 50, Adam (beta 0.9, 0.999) with step 0.1 on mu and 0.01 on sigma, sigma 0.1 in
+ *         [1e-3, 2], antithetic sampling, K = 1 (mixture logits' Adam step 0.01);
+ *   PEPG: the reference code's settings: k = 51 (the mean and 25 antithetic pairs), lr 0.1
+ *         decaying 0.99 a step, momentum 0.9, sigma 0.1 in [1e-6, 0.15] (the reference clips
+ *         at 0; a tiny floor keeps the score finite), sigma step 0.2, sigma decay 0.999.
+ * The step sizes of NES were chosen by measurement (tests/test_viewfool.c, bench_attack). */
 void vf_attack_config_default(vf_attack_config *cfg, vf_attack_method method);
 
 /* VF_EINPUT with a one-line reason when a field is out of range (for example PEPG with K > 1,
- * an odd PEPG k, sigma_min <= 0). */
+ * an even PEPG k, sigma_min <= 0). */
 vf_status vf_attack_config_check(const vf_attack_config *cfg);
 
 /* Every field as a JSON object (a new reference); the seed as a decimal string. */
@@ -154,7 +178,7 @@ typedef struct vf_attack_state {
     double sigma[VF_ATTACK_MAX_COMPONENTS][VF_VIEW_DIM];
     double logit[VF_ATTACK_MAX_COMPONENTS]; /* mixture weights are softmax(logit) */
 
-    /* Optimizer memory over the parameter vector (per component: mu, log sigma, logit).
+    /* Optimizer memory over the parameter vector (per component: mu, sigma, logit).
      * NES: Adam's first and second moments. PEPG: moment1[0..5] is the velocity of mu. */
     double moment1[VF_ATTACK_MAX_PARAMS], moment2[VF_ATTACK_MAX_PARAMS];
 
@@ -200,10 +224,10 @@ vf_status vf_attack_run(vf_attack_state *st, const vf_attack_config *cfg,
                         void *hook_ctx);
 
 /* The NES ascent direction at the current state, estimated from cfg->samples samples drawn
- * from rng (not the state's): what vf_attack_step feeds to Adam (loss term plus lambda times
- * the entropy term, natural-gradient scaled when configured). grad gets components * 13
- * numbers laid out per component as d/dmu[6], d/dlog sigma[6], d/dlogit. For tests and
- * diagnostics; NES only (VF_EINPUT for PEPG). */
+ * from rng (not the state's): what vf_attack_step feeds to Adam, the natural gradient of the
+ * loss term plus lambda times the plain entropy gradient. grad gets components * 13 numbers
+ * laid out per component as d/dmu[6], d/dsigma[6], d/dlogit. For tests and diagnostics; NES
+ * only (VF_EINPUT for PEPG). */
 vf_status vf_attack_estimate_gradient(const vf_attack_state *st, const vf_attack_config *cfg,
                                       vf_attack_loss_fn loss_fn, void *ctx, vf_rng *rng,
                                       double *grad);
@@ -226,10 +250,12 @@ void vf_attack_weights(const vf_attack_state *st, double *weights);
 void vf_attack_component_view(const vf_attack_state *st, const vf_attack_config *cfg, int c,
                               double v[VF_VIEW_DIM]);
 
-/* The attack's answer v*: NES: a * tanh(mu*) + b of the heaviest component; PEPG: the best
- * sample of the last step (the centre before any step). */
-void vf_attack_best_view(const vf_attack_state *st, const vf_attack_config *cfg,
-                         double v[VF_VIEW_DIM]);
+/* v* = a * tanh(mu*) + b of the heaviest component: the paper's answer, for every method. */
+void vf_attack_v_star(const vf_attack_state *st, const vf_attack_config *cfg,
+                      double v[VF_VIEW_DIM]);
+
+/* The best sample of the last step (the reference code's answer; the centre before any step). */
+void vf_attack_v_best(const vf_attack_state *st, double v[VF_VIEW_DIM]);
 
 /* n viewpoints drawn from the learned p*(v) with the caller's rng (the state is unchanged),
  * written to views (n x 6). */
@@ -239,9 +265,10 @@ void vf_attack_sample_views(const vf_attack_state *st, const vf_attack_config *c
 /* Per-parameter standard deviation (divisor n - 1; 0 when n < 2) of n viewpoints. */
 void vf_view_std(const double *views, int n, double std[VF_VIEW_DIM]);
 
-/* "Camera fluctuation": n viewpoints uniform in the box centre +- (r_percent / 100) * (hi - lo)
- * per parameter, clipped to the bounds, written to views (n x 6). */
-void vf_view_fluctuation(const vf_view_bounds *bounds, const double centre[VF_VIEW_DIM],
+/* "Camera fluctuation": n viewpoints uniform in the box centre +- (r_percent / 100) * range
+ * per parameter (range: vf_view_ranges_paper, so r means the same in every workspace),
+ * clipped to the default box joined with `search` (the attack's box), written to views. */
+void vf_view_fluctuation(const vf_view_bounds *search, const double centre[VF_VIEW_DIM],
                          double r_percent, vf_rng *rng, int n, double *views);
 
 /* Call loss_fn on n viewpoints in one batch. losses (n, may be NULL) gets the losses; *asr

@@ -57,7 +57,9 @@ vf_status vf_stage_begin(vf_workspace *ws, const char *stage, vf_stage *s);
 /* Like vf_stage_begin, but keep what an interrupted run left in the staging folder (a stage
  * that checkpoints there continues from it); the folder is created when missing. */
 vf_status vf_stage_resume(vf_workspace *ws, const char *stage, vf_stage *s);
-/* Swap the staging folder in and record params and summary (both stolen; either may be NULL). */
+/* Swap the staging folder in and record params and summary (both stolen; either may be NULL).
+ * On failure nothing is lost: the new output stays in the staging folder (for a retry or a
+ * resume) and the stage's previous output and manifest record stay as they were. */
 vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary);
 void vf_stage_abort(vf_stage *s);
 

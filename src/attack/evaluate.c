@@ -44,10 +44,13 @@ static vf_status measure(vf_view_loss *vl, const vf_view_bounds *bounds, uint64_
 {
     vf_status status = vf_view_loss_classify(vl, ev->v_star, 1, &ev->v_star_pred, NULL);
     if (status == VF_OK)
+        status = vf_view_loss_classify(vl, ev->v_best, 1, &ev->v_best_pred, NULL);
+    if (status == VF_OK)
         status = vf_view_loss_classify(vl, ev->samples, ev->sample_count, ev->sample_pred, NULL);
     if (status != VF_OK)
         return status;
     ev->asr_v_star = !ev->v_star_pred.correct;
+    ev->asr_v_best = !ev->v_best_pred.correct;
     ev->asr_samples = fooled_rate(ev->sample_pred, ev->sample_count);
     vf_view_std(ev->samples, ev->sample_count, ev->sample_std);
     count_wrong_classes(ev);
@@ -69,7 +72,8 @@ vf_status vf_attack_eval_distribution(vf_view_loss *vl, const vf_attack_state *s
                                       vf_attack_eval *out)
 {
     memset(out, 0, sizeof *out);
-    vf_attack_best_view(st, cfg, out->v_star);
+    vf_attack_v_star(st, cfg, out->v_star);
+    vf_attack_v_best(st, out->v_best);
     vf_rng rng;
     vf_rng_seed(&rng, seed ^ SAMPLE_STREAM);
     out->sample_count = VF_EVAL_SAMPLES;
@@ -89,6 +93,7 @@ vf_status vf_attack_eval_random(vf_view_loss *vl, const vf_view_bounds *bounds, 
         return status;
     out->sample_count = VF_EVAL_SAMPLES;
     memcpy(out->v_star, rs.best_view, sizeof out->v_star);
+    memcpy(out->v_best, rs.best_view, sizeof out->v_best);
     return measure(vl, bounds, seed, out);
 }
 
@@ -118,15 +123,20 @@ json_t *vf_attack_eval_to_json(const vf_attack_eval *ev)
         json_array_append_new(wrong, json_pack("{s:i, s:s, s:i}", "class", ev->wrong_class[i],
                                                "name", vf_class_short_name(ev->wrong_class[i]),
                                                "count", ev->wrong_votes[i]));
-    double r[VF_FLUCT_LEVELS];
+    double r[VF_FLUCT_LEVELS], range[VF_VIEW_DIM];
     for (int i = 0; i < VF_FLUCT_LEVELS; i++)
         r[i] = i + 1;
-    return json_pack("{s:o, s:o, s:f, s:o, s:o, s:f, s:o, s:{s:o, s:o, s:i}, s:o}", "v_star",
-                     doubles_json(ev->v_star, VF_VIEW_DIM), "v_star_prediction",
-                     vf_view_prediction_to_json(&ev->v_star_pred), "asr_v_star", ev->asr_v_star,
-                     "samples", samples, "sample_predictions", preds, "asr_samples",
-                     ev->asr_samples, "sample_std", doubles_json(ev->sample_std, VF_VIEW_DIM),
-                     "fluctuation", "r_percent", doubles_json(r, VF_FLUCT_LEVELS), "asr",
-                     doubles_json(ev->fluct_asr, VF_FLUCT_LEVELS), "samples_per_level",
-                     VF_FLUCT_SAMPLES, "top_wrong_classes", wrong);
+    vf_view_ranges_paper(range);
+    json_t *doc = json_pack(
+        "{s:o, s:o, s:f, s:o, s:o, s:f, s:o, s:o, s:o, s:f, s:o, s:{s:o, s:o, s:i}, s:o}",
+        "v_star", doubles_json(ev->v_star, VF_VIEW_DIM), "v_star_prediction",
+        vf_view_prediction_to_json(&ev->v_star_pred), "asr_v_star", ev->asr_v_star, "v_best",
+        doubles_json(ev->v_best, VF_VIEW_DIM), "v_best_prediction",
+        vf_view_prediction_to_json(&ev->v_best_pred), "asr_v_best", ev->asr_v_best,
+        "measure_ranges", doubles_json(range, VF_VIEW_DIM), "samples", samples,
+        "sample_predictions", preds, "asr_samples", ev->asr_samples, "sample_std",
+        doubles_json(ev->sample_std, VF_VIEW_DIM), "fluctuation", "r_percent",
+        doubles_json(r, VF_FLUCT_LEVELS), "asr", doubles_json(ev->fluct_asr, VF_FLUCT_LEVELS),
+        "samples_per_level", VF_FLUCT_SAMPLES, "top_wrong_classes", wrong);
+    return doc;
 }

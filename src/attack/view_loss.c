@@ -16,7 +16,8 @@ struct vf_view_loss {
     int labels[VF_MAX_LABELS], label_count;
     vf_image images[VF_VIEW_LOSS_CHUNK]; /* render targets, reused */
     float *batch;                         /* chunk x 3 x S x S network input */
-    float *probs;                         /* chunk x 1000 */
+    float *logits;                        /* chunk x 1000 */
+    double losses[VF_VIEW_LOSS_CHUNK];    /* the chunk's label-set cross-entropies */
     vf_view_loss_stats stats;
 };
 
@@ -31,8 +32,8 @@ vf_status vf_view_loss_create(const vf_field *field, vf_classifier *cls, vf_view
     vl->camera = vf_field_classifier_camera(field, vl->size);
     size_t plane = (size_t)vl->size * (size_t)vl->size;
     vl->batch = malloc(VF_VIEW_LOSS_CHUNK * 3 * plane * sizeof(float));
-    vl->probs = malloc(VF_VIEW_LOSS_CHUNK * VF_NUM_CLASSES * sizeof(float));
-    if (!vl->batch || !vl->probs) {
+    vl->logits = malloc(VF_VIEW_LOSS_CHUNK * VF_NUM_CLASSES * sizeof(float));
+    if (!vl->batch || !vl->logits) {
         vf_view_loss_free(vl);
         return vf_fail(VF_EINTERNAL, "out of memory for the classifier batch");
     }
@@ -47,7 +48,7 @@ void vf_view_loss_free(vf_view_loss *vl)
     for (int i = 0; i < VF_VIEW_LOSS_CHUNK; i++)
         vf_image_free(&vl->images[i]);
     free(vl->batch);
-    free(vl->probs);
+    free(vl->logits);
     free(vl);
 }
 
@@ -68,23 +69,18 @@ vf_camera vf_view_loss_camera(const vf_view_loss *vl) { return vl->camera; }
 
 vf_view_loss_stats vf_view_loss_get_stats(const vf_view_loss *vl) { return vl->stats; }
 
-double vf_view_loss_of(double label_prob)
+/* One view's prediction from its logits (overwritten with probabilities) and its loss. */
+static void predict(const vf_view_loss *vl, float *logits, vf_view_prediction *out, double *loss)
 {
-    return -log(label_prob > VF_VIEW_LOSS_FLOOR ? label_prob : VF_VIEW_LOSS_FLOOR);
-}
-
-static void predict(const vf_view_loss *vl, const float *probs, vf_view_prediction *out)
-{
+    *loss = vf_label_set_cross_entropy(logits, vl->labels, vl->label_count);
+    vf_softmax(logits, VF_NUM_CLASSES);
     int top;
-    vf_topk(probs, 1, &top, &out->top_prob);
+    vf_topk(logits, 1, &top, &out->top_prob);
     out->top_class = top;
-    double sum = 0.0;
     out->correct = 0;
-    for (int i = 0; i < vl->label_count; i++) {
-        sum += probs[vl->labels[i]];
+    for (int i = 0; i < vl->label_count; i++)
         out->correct |= vl->labels[i] == top;
-    }
-    out->label_prob = (float)sum;
+    out->label_prob = (float)exp(-*loss);
 }
 
 /* Classify the n (<= chunk) images already rendered into vl->images. */
@@ -95,11 +91,11 @@ static vf_status classify_rendered(vf_view_loss *vl, int n, vf_view_prediction *
 #pragma omp parallel for
     for (int i = 0; i < n; i++)
         vf_classifier_normalize(&vl->images[i], vl->batch + (size_t)i * stride);
-    vf_status status = vf_classifier_forward(vl->cls, vl->batch, n, vl->probs);
+    vf_status status = vf_classifier_logits(vl->cls, vl->batch, n, vl->logits);
     if (status != VF_OK)
         return status;
     for (int i = 0; i < n; i++)
-        predict(vl, vl->probs + (size_t)i * VF_NUM_CLASSES, &out[i]);
+        predict(vl, vl->logits + (size_t)i * VF_NUM_CLASSES, &out[i], &vl->losses[i]);
     vl->stats.classify_seconds += vf_now() - t0;
     vl->stats.views += n;
     return VF_OK;
@@ -121,7 +117,7 @@ vf_status vf_view_loss_classify(vf_view_loss *vl, const double *views, int n,
         if (status != VF_OK)
             return status;
         for (int i = 0; losses && i < m; i++)
-            losses[first + i] = vf_view_loss_of(out[first + i].label_prob);
+            losses[first + i] = vl->losses[i];
     }
     return VF_OK;
 }

@@ -129,44 +129,55 @@ void field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], fl
     const int use_tv = tv_density > 0 || tv_color > 0;
     const int threads = adam->threads;
 
+    /* One sink per training thread. The team here may be smaller than `threads` (OpenMP may
+     * give fewer, e.g. with OMP_DYNAMIC), so each thread serves sinks me, me + team, ...: every
+     * sink is applied whatever the team's size. The barriers sit outside those loops. */
 #pragma omp parallel num_threads(threads)
     {
-        const int me = omp_get_thread_num();
-        field_grad_sink *mine = &adam->sinks[me];
+        const int me = omp_get_thread_num(), team = omp_get_num_threads();
         for (int g = 0; g < f->grid_count; g++) {
             field_grid *grid = &f->grids[g];
             /* 1. the owner of each point gathers its total gradient into its own sink */
-            for (size_t k = 0; k < mine->count[g]; k++) {
-                size_t i = mine->list[g][k];
-                if (owner(adam, g, i) != me)
-                    continue;
-                float *total = mine->grad[g] + i * FIELD_CH;
-                for (int s = me + 1; s < threads; s++)
-                    if (adam->sinks[s].touched[g][i]) {
-                        const float *other = adam->sinks[s].grad[g] + i * FIELD_CH;
-                        for (int ch = 0; ch < FIELD_CH; ch++)
-                            total[ch] += other[ch];
-                    }
-                if (use_tv)
-                    add_tv(grid, i, tv_density, tv_color, total);
+            for (int o = me; o < threads; o += team) {
+                field_grad_sink *mine = &adam->sinks[o];
+                for (size_t k = 0; k < mine->count[g]; k++) {
+                    size_t i = mine->list[g][k];
+                    if (owner(adam, g, i) != o)
+                        continue;
+                    float *total = mine->grad[g] + i * FIELD_CH;
+                    for (int s = o + 1; s < threads; s++)
+                        if (adam->sinks[s].touched[g][i]) {
+                            const float *other = adam->sinks[s].grad[g] + i * FIELD_CH;
+                            for (int ch = 0; ch < FIELD_CH; ch++)
+                                total[ch] += other[ch];
+                        }
+                    if (use_tv)
+                        add_tv(grid, i, tv_density, tv_color, total);
+                }
             }
 #pragma omp barrier
-            /* 2. update the points it owns; clear everything it touched */
-            for (size_t k = 0; k < mine->count[g]; k++) {
-                size_t i = mine->list[g][k];
-                float *grad = mine->grad[g] + i * FIELD_CH;
-                if (owner(adam, g, i) == me)
-                    adam_update(grid->values + i * FIELD_CH, adam->m[g] + i * FIELD_CH,
-                                adam->v[g] + i * FIELD_CH, grad, step_size, adam->beta1,
-                                adam->beta2, eps_hat);
+            /* 2. update the points it owns */
+            for (int o = me; o < threads; o += team) {
+                field_grad_sink *mine = &adam->sinks[o];
+                for (size_t k = 0; k < mine->count[g]; k++) {
+                    size_t i = mine->list[g][k];
+                    if (owner(adam, g, i) == o)
+                        adam_update(grid->values + i * FIELD_CH, adam->m[g] + i * FIELD_CH,
+                                    adam->v[g] + i * FIELD_CH, mine->grad[g] + i * FIELD_CH,
+                                    step_size, adam->beta1, adam->beta2, eps_hat);
+                }
             }
 #pragma omp barrier
-            for (size_t k = 0; k < mine->count[g]; k++) {
-                size_t i = mine->list[g][k];
-                memset(mine->grad[g] + i * FIELD_CH, 0, FIELD_CH * sizeof(float));
-                mine->touched[g][i] = 0;
+            /* 3. clear everything each sink touched */
+            for (int o = me; o < threads; o += team) {
+                field_grad_sink *mine = &adam->sinks[o];
+                for (size_t k = 0; k < mine->count[g]; k++) {
+                    size_t i = mine->list[g][k];
+                    memset(mine->grad[g] + i * FIELD_CH, 0, FIELD_CH * sizeof(float));
+                    mine->touched[g][i] = 0;
+                }
+                mine->count[g] = 0;
             }
-            mine->count[g] = 0;
         }
     }
 }

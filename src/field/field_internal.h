@@ -248,12 +248,16 @@ typedef struct field_render_setup {
 
 void field_render_setup_init(const vf_field *f, field_render_setup *setup);
 
-/* The opacity of a sample of raw density d >= visible_density, from the grid's table. */
+/* The opacity of a sample of raw density d >= visible_density, from the grid's table. The
+ * index is clamped both ways (and a NaN takes the last entry), so no value can read outside
+ * the table. */
 static inline float field_render_alpha(const field_render_grid *r, float d)
 {
     const float u = (d - r->visible_density) * r->alpha_per_density;
-    if (u >= (float)FIELD_ALPHA_TABLE)
+    if (!(u < (float)FIELD_ALPHA_TABLE))
         return r->alpha[FIELD_ALPHA_TABLE];
+    if (!(u > 0.0f))
+        return r->alpha[0];
     const int i = (int)u;
     return r->alpha[i] + (u - (float)i) * (r->alpha[i + 1] - r->alpha[i]);
 }

@@ -11,9 +11,11 @@
  * renamed, so an interrupted save never leaves a half file under the real name. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "trainer_internal.h"
@@ -93,7 +95,9 @@ static vf_status finish_write(stream *s, const char *tmp)
         return VF_OK;
     saved_errno = errno ? errno : saved_errno;
     remove(tmp);
-    return vf_fail(VF_EINPUT, "cannot write %s: %s", s->path, strerror(saved_errno));
+    /* as vf_write_file_atomic: a file that opened but cannot be written (a full disk, an I/O
+     * error) is a failure of the machine, exit 2, not bad input */
+    return vf_fail(VF_EINTERNAL, "cannot write %s: %s", s->path, strerror(saved_errno));
 }
 
 static vf_status open_for_read(stream *s, const char *path)
@@ -183,22 +187,54 @@ static void write_model(stream *s, const vf_field *f)
     free(buf);
 }
 
-static int header_sane(const model_header *h)
+static int finite_in(double x, double lo, double hi)
+{
+    return isfinite(x) && x >= lo && x <= hi;
+}
+
+/* Everything a model file says is checked before it is trusted (files travel between people):
+ * every number finite and in a range training can produce, with margins. The bounds also keep
+ * the renderer finite: with step_ratio >= 1e-3 and at most 4096 points an axis a ray takes
+ * fewer than 1.3e7 samples a grid, so the float sample counters of the marchers (exact to
+ * 2^24) always advance. NULL when sane, else what is wrong. */
+static const char *header_problem(const model_header *h)
 {
     if (h->grid_count < 1 || h->grid_count > FIELD_MAX_GRIDS || h->channels != FIELD_CH_USED)
-        return 0;
-    if (h->camera_size[0] < 1 || h->camera_size[1] < 1 || !(h->camera[0] > 0) || !(h->camera[1] > 0))
-        return 0;
-    if (!(h->step_ratio > 0) || !(h->density_scale > 0))
-        return 0;
+        return "grid count or channels";
+    if (h->camera_size[0] < 1 || h->camera_size[1] < 1 || h->camera_size[0] > 100000 ||
+        h->camera_size[1] > 100000)
+        return "camera size";
+    for (int i = 0; i < 8; i++)
+        if (!finite_in(h->camera[i], i < 2 ? 1e-6 : -1e7, 1e7))
+            return "camera";
+    if (!finite_in(h->step_ratio, 1e-3, 10) || !finite_in(h->density_scale, 1e-6, 1e6) ||
+        !finite_in(h->density_shift, -1e3, 1e3))
+        return "step or density scale";
+    if (!finite_in(h->occupancy_alpha, 0, 1) || !finite_in(h->stop_transmittance, 0, 1))
+        return "occupancy or stop threshold";
+    for (int c = 0; c < 3; c++)
+        if (!finite_in(h->background[c], 0, 1) || !finite_in(h->scene_center[c], -1e6, 1e6))
+            return "background or scene centre";
+    if (!finite_in(h->camera_distance, 0, 1e6))
+        return "camera distance";
     for (uint32_t i = 0; i < h->grid_count; i++) {
-        if (!(h->voxel[i] > 0))
-            return 0;
+        if (!finite_in(h->voxel[i], 1e-6, 1e3))
+            return "voxel size";
         for (int a = 0; a < 3; a++)
-            if (h->dim[i][a] < 2 || h->dim[i][a] > 4096)
-                return 0;
+            if (h->dim[i][a] < 2 || h->dim[i][a] > 4096 || !finite_in(h->lo[i][a], -1e4, 1e4))
+                return "grid box";
     }
-    return 1;
+    return NULL;
+}
+
+/* Bytes left in the file from the current position (-1 when it cannot be told). */
+static long long bytes_left(stream *s)
+{
+    struct stat st;
+    long here = ftell(s->fp);
+    if (here < 0 || fstat(fileno(s->fp), &st) != 0)
+        return -1;
+    return (long long)st.st_size - here;
 }
 
 /* Read a model; `what` names the kind of file for messages. */
@@ -224,8 +260,19 @@ static vf_status read_model(stream *s, vf_field **out)
     get(s, &h, sizeof h);
     if (s->failed)
         return vf_fail(VF_EINPUT, "%s is truncated", s->path);
-    if (!header_sane(&h))
-        return vf_fail(VF_EINPUT, "%s is corrupt (impossible header values)", s->path);
+    const char *problem = header_problem(&h);
+    if (problem)
+        return vf_fail(VF_EINPUT, "%s is corrupt (impossible header values: %s)", s->path,
+                       problem);
+    /* The grids must fit in what is left of the file before any memory is taken for them. */
+    unsigned long long need = 0;
+    for (uint32_t i = 0; i < h.grid_count; i++)
+        need += (unsigned long long)h.dim[i][0] * h.dim[i][1] * h.dim[i][2] * FIELD_CH_USED *
+                sizeof(float);
+    long long left = bytes_left(s);
+    if (left >= 0 && need > (unsigned long long)left)
+        return vf_fail(VF_EINPUT, "%s is truncated or corrupt (its header claims %.0f MB of "
+                       "grids, the file holds %.0f MB)", s->path, need / 1e6, left / 1e6);
 
     vf_field *f = calloc(1, sizeof *f);
     if (!f)
@@ -262,6 +309,14 @@ static vf_status read_model(stream *s, vf_field **out)
         for (size_t start = 0; start < g->points && !s->failed; start += CHUNK) {
             size_t n = g->points - start < CHUNK ? g->points - start : CHUNK;
             get(s, buf, n * FIELD_CH_USED * sizeof(float));
+            for (size_t p = 0; p < n * FIELD_CH_USED && !s->failed; p++)
+                if (!isfinite(buf[p]) || fabsf(buf[p]) > 1e8f) {
+                    status = vf_fail(VF_EINPUT, "%s is corrupt (grid value %g)", s->path,
+                                     (double)buf[p]);
+                    break;
+                }
+            if (status != VF_OK)
+                break;
             for (size_t p = 0; p < n; p++)
                 memcpy(g->values + (start + p) * FIELD_CH, buf + p * FIELD_CH_USED,
                        FIELD_CH_USED * sizeof(float));
@@ -390,6 +445,15 @@ vf_status trainer_checkpoint_read(vf_field_trainer *t, const char *path)
             status = vf_fail(VF_EINPUT, "%s is truncated or from another build", path);
         else if (st.fingerprint != trainer_views_fingerprint(t))
             status = vf_fail(VF_EINPUT, "%s was made from other training images or poses", path);
+        else if (st.options.seconds != t->opt.seconds || st.options.steps != t->opt.steps ||
+                 st.options.keep_background != t->opt.keep_background)
+            /* the schedule (upsampling, pruning) is laid out over the budget: refuse a new one
+             * rather than silently keep the old, so what ran is what the user asked */
+            status = vf_fail(VF_EINPUT, "the interrupted training in %s ran with a budget of "
+                             "%g%s%s; give the same budget to continue it, or --restart", path,
+                             st.options.seconds > 0 ? st.options.seconds / 60 : st.options.steps,
+                             st.options.seconds > 0 ? " minutes" : " steps",
+                             st.options.keep_background ? " with --keep-background" : "");
     }
     vf_field *f = NULL;
     if (status == VF_OK)

@@ -1,4 +1,5 @@
 /* Rendering whole images from a field: one ray per pixel, rows spread over the cores. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,12 +48,21 @@ static vf_status check_camera(const vf_camera *cam)
     return VF_OK;
 }
 
-/* Render one image into rgb (3 floats a pixel), depth and opacity (1 float a pixel; may be
- * NULL), with the field's render setup (made once for a batch of images). Runs in the calling
- * thread; `parallel` spreads rows over the cores. */
+/* Camera-to-world matrices from files (targets, a user's --pose) are checked: a NaN or huge
+ * pose would send every ray through NaN arithmetic. */
+static vf_status check_poses(const double *c2w, int n)
+{
+    for (int i = 0; i < 16 * n; i++)
+        if (!(fabs(c2w[i]) < 1e6))
+            return vf_fail(VF_EINPUT, "cannot render from a camera pose with the value %g",
+                           c2w[i]);
+    return VF_OK;
+}
+
+/* Render one image into rgb (3 floats a pixel) with the field's render setup (made once for a
+ * batch of images). Runs in the calling thread; `parallel` spreads rows over the cores. */
 static void render_rows(const vf_field *f, const field_render_setup *setup, const vf_camera *cam,
-                        const double c2w[16], float *rgb, float *depth, float *opacity,
-                        int parallel)
+                        const double c2w[16], float *rgb, int parallel)
 {
     enum { RUN = 64 }; /* pixels of a row marched together (field_render_rays) */
     const int width = cam->width, height = cam->height;
@@ -67,25 +77,18 @@ static void render_rows(const vf_field *f, const field_render_setup *setup, cons
             field_render_rays(f, setup, rays, n, 0.5f, f->stop_transmittance, res);
             for (int j = 0; j < n; j++) {
                 const size_t i = (size_t)y * width + x0 + j;
-                if (rgb)
-                    memcpy(rgb + 3 * i, res[j].rgb, sizeof res[j].rgb);
-                const float opaque = 1.0f - res[j].trans;
-                if (depth)
-                    depth[i] = opaque > 1e-4f ? res[j].depth / opaque : 0.0f;
-                if (opacity)
-                    opacity[i] = opaque;
+                memcpy(rgb + 3 * i, res[j].rgb, sizeof res[j].rgb);
             }
         }
     }
 }
 
 /* One image, its rows spread over the cores. */
-static void render_one(const vf_field *f, const vf_camera *cam, const double c2w[16], float *rgb,
-                       float *depth, float *opacity)
+static void render_one(const vf_field *f, const vf_camera *cam, const double c2w[16], float *rgb)
 {
     field_render_setup setup;
     field_render_setup_init(f, &setup);
-    render_rows(f, &setup, cam, c2w, rgb, depth, opacity, 1);
+    render_rows(f, &setup, cam, c2w, rgb, 1);
 }
 
 vf_status vf_field_render(const vf_field *f, const vf_camera *cam, const double c2w[16],
@@ -93,9 +96,11 @@ vf_status vf_field_render(const vf_field *f, const vf_camera *cam, const double 
 {
     vf_status status = check_camera(cam);
     if (status == VF_OK)
+        status = check_poses(c2w, 1);
+    if (status == VF_OK)
         status = ensure_image(out, cam->width, cam->height, 3);
     if (status == VF_OK)
-        render_one(f, cam, c2w, out->data, NULL, NULL);
+        render_one(f, cam, c2w, out->data);
     return status;
 }
 
@@ -103,6 +108,8 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
                                 vf_image *out)
 {
     vf_status status = check_camera(cam);
+    if (status == VF_OK)
+        status = check_poses(c2w, n);
     for (int i = 0; status == VF_OK && i < n; i++)
         status = ensure_image(&out[i], cam->width, cam->height, 3);
     if (status != VF_OK)
@@ -114,10 +121,10 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
     if ((size_t)cam->width * cam->height <= 512 * 512 && n > 1) {
 #pragma omp parallel for schedule(dynamic, 1)
         for (int i = 0; i < n; i++)
-            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, NULL, NULL, 0);
+            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, 0);
     } else {
         for (int i = 0; i < n; i++)
-            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, NULL, NULL, 1);
+            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, 1);
     }
     return VF_OK;
 }
@@ -137,19 +144,6 @@ vf_status vf_field_render_viewpoints(const vf_field *f, const vf_camera *cam,
     return status;
 }
 
-vf_status vf_field_render_depth(const vf_field *f, const vf_camera *cam, const double c2w[16],
-                                vf_image *depth, vf_image *opacity)
-{
-    vf_status status = check_camera(cam);
-    if (status == VF_OK && depth)
-        status = ensure_image(depth, cam->width, cam->height, 1);
-    if (status == VF_OK && opacity)
-        status = ensure_image(opacity, cam->width, cam->height, 1);
-    if (status == VF_OK)
-        render_one(f, cam, c2w, NULL, depth ? depth->data : NULL, opacity ? opacity->data : NULL);
-    return status;
-}
-
 vf_camera vf_field_classifier_camera(const vf_field *f, int size)
 {
     const vf_camera *ref = &f->camera;
@@ -164,19 +158,9 @@ vf_camera vf_field_classifier_camera(const vf_field *f, int size)
     return cam;
 }
 
-vf_camera vf_field_training_camera(const vf_field *f)
-{
-    return f->camera;
-}
-
 void vf_field_background(const vf_field *f, float rgb[3])
 {
     memcpy(rgb, f->background, 3 * sizeof(float));
-}
-
-void vf_field_set_background(vf_field *f, const float rgb[3])
-{
-    memcpy(f->background, rgb, 3 * sizeof(float));
 }
 
 void vf_field_get_info(const vf_field *f, vf_field_info *info)

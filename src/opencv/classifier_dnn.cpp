@@ -7,6 +7,7 @@
 
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <string>
 
@@ -27,7 +28,9 @@ extern "C" vf_status vf_dnn_load(const char *path, vf_dnn **out)
             CV_Error(cv::Error::StsParseError, "it holds no network");
         dnn->net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
         dnn->net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
-        cv::setNumThreads(cv::getNumberOfCPUs());
+        // OpenCV's thread count is process-wide: set it once, not on every model open.
+        static std::once_flag threads_once;
+        std::call_once(threads_once, [] { cv::setNumThreads(cv::getNumberOfCPUs()); });
         *out = dnn.release();
     } catch (const cv::Exception &e) {
         // "Failed to parse ONNX model: PATH": we name the path ourselves.

@@ -9,13 +9,11 @@ void vf_attack_config_default(vf_attack_config *cfg, vf_attack_method method)
     memset(cfg, 0, sizeof *cfg);
     vf_view_bounds_default(&cfg->bounds);
     cfg->method = method;
-    cfg->samples = 50;
     cfg->steps = 100;
+    cfg->lambda = 0.01;
     cfg->lr = 0.1;
     cfg->seed = 0;
     cfg->sigma_init = 0.1;
-    cfg->sigma_min = 1e-3;
-    cfg->natural_gradient = 1;
     cfg->antithetic = 1;
     cfg->components = 1;
     cfg->weight_lr = 0.01;
@@ -23,13 +21,17 @@ void vf_attack_config_default(vf_attack_config *cfg, vf_attack_method method)
     cfg->adam_beta2 = 0.999;
     cfg->momentum = 0.9;
     cfg->lr_decay = 0.99;
-    cfg->sigma_lr = 0.2;
+    cfg->sigma_decay = 0.999;
     if (method == VF_ATTACK_PEPG) {
-        cfg->lambda = 0.0;
+        cfg->samples = 51;
+        cfg->sigma_min = 1e-6;
         cfg->sigma_max = 0.15;
+        cfg->sigma_lr = 0.2;
     } else {
-        cfg->lambda = 0.01;
+        cfg->samples = 50;
+        cfg->sigma_min = 1e-3;
         cfg->sigma_max = 2.0;
+        cfg->sigma_lr = 0.01;
     }
 }
 
@@ -47,9 +49,9 @@ vf_status vf_attack_config_check(const vf_attack_config *cfg)
         return vf_fail(VF_EINPUT, "unknown attack method %d", (int)cfg->method);
     if (cfg->samples < 2 || cfg->samples > 1000000)
         return vf_fail(VF_EINPUT, "samples per step is %d: use 2 to 1000000", cfg->samples);
-    if (cfg->method == VF_ATTACK_PEPG && cfg->samples % 2)
-        return vf_fail(VF_EINPUT, "PEPG evaluates antithetic pairs: samples per step (%d) must "
-                       "be even", cfg->samples);
+    if (cfg->method == VF_ATTACK_PEPG && (cfg->samples < 3 || cfg->samples % 2 == 0))
+        return vf_fail(VF_EINPUT, "PEPG evaluates the mean and antithetic pairs: samples per "
+                       "step (%d) must be odd and at least 3", cfg->samples);
     if (cfg->steps < 0)
         return vf_fail(VF_EINPUT, "steps is %d: use 0 or more", cfg->steps);
     if (!in_range(cfg->lambda, 0, 1e6))
@@ -71,10 +73,12 @@ vf_status vf_attack_config_check(const vf_attack_config *cfg)
     if (!in_range(cfg->adam_beta1, 0, 0.999999) || !in_range(cfg->adam_beta2, 0, 0.999999))
         return vf_fail(VF_EINPUT, "Adam betas %g, %g must lie in [0, 1)", cfg->adam_beta1,
                        cfg->adam_beta2);
+    if (!in_range(cfg->sigma_lr, 0, 1e3))
+        return vf_fail(VF_EINPUT, "sigma step %g must be >= 0", cfg->sigma_lr);
     if (!in_range(cfg->momentum, 0, 0.999999) || !in_range(cfg->lr_decay, 1e-6, 1) ||
-        !in_range(cfg->sigma_lr, 0, 1e3))
-        return vf_fail(VF_EINPUT, "PEPG momentum %g must lie in [0, 1), lr decay %g in (0, 1], "
-                       "sigma lr %g >= 0", cfg->momentum, cfg->lr_decay, cfg->sigma_lr);
+        !in_range(cfg->sigma_decay, 1e-6, 1))
+        return vf_fail(VF_EINPUT, "PEPG momentum %g must lie in [0, 1), lr decay %g and sigma "
+                       "decay %g in (0, 1]", cfg->momentum, cfg->lr_decay, cfg->sigma_decay);
     return VF_OK;
 }
 

@@ -1,17 +1,56 @@
 /* The viewpoint box, the tanh squashing and the entropy of the squashed Gaussian. */
 #include <math.h>
 #include <pthread.h>
+#include <string.h>
 
 #include "viewfool_internal.h"
 
+#define FIXED_HALF 1e-6 /* half-width of a parameter a search space keeps fixed */
+
+static const double default_lo[VF_VIEW_DIM] = {-180, -30, 20, -0.5, -1, -0.5};
+static const double default_hi[VF_VIEW_DIM] = {180, 30, 160, 0.5, 1, 0.5};
+
 void vf_view_bounds_default(vf_view_bounds *bounds)
 {
-    static const double lo[VF_VIEW_DIM] = {-180, -30, 20, -0.5, -1, -0.5};
-    static const double hi[VF_VIEW_DIM] = {180, 30, 160, 0.5, 1, 0.5};
     for (int i = 0; i < VF_VIEW_DIM; i++) {
-        bounds->lo[i] = lo[i];
-        bounds->hi[i] = hi[i];
+        bounds->lo[i] = default_lo[i];
+        bounds->hi[i] = default_hi[i];
     }
+}
+
+void vf_view_ranges_paper(double range[VF_VIEW_DIM])
+{
+    for (int i = 0; i < VF_VIEW_DIM; i++)
+        range[i] = default_hi[i] - default_lo[i];
+}
+
+static const char *const space_names[3] = {"both", "rotation", "translation"};
+
+vf_status vf_view_space_parse(const char *name, vf_view_space *space)
+{
+    for (int s = 0; s < 3; s++)
+        if (name && !strcmp(name, space_names[s])) {
+            *space = (vf_view_space)s;
+            return VF_OK;
+        }
+    return vf_fail(VF_EINPUT, "the search space must be rotation, translation or both, not '%s'",
+                   name ? name : "");
+}
+
+const char *vf_view_space_name(vf_view_space space)
+{
+    return (unsigned)space < 3 ? space_names[space] : "?";
+}
+
+void vf_view_bounds_restrict(vf_view_bounds *bounds, vf_view_space space,
+                             const double at[VF_VIEW_DIM])
+{
+    for (int i = 0; i < VF_VIEW_DIM; i++)
+        if ((space == VF_SPACE_ROTATION && i >= 3) || (space == VF_SPACE_TRANSLATION && i < 3)) {
+            double v = at ? clamp(at[i], bounds->lo[i], bounds->hi[i]) : view_centre(bounds, i);
+            bounds->lo[i] = v - FIXED_HALF;
+            bounds->hi[i] = v + FIXED_HALF;
+        }
 }
 
 vf_status vf_view_bounds_check(const vf_view_bounds *bounds)
@@ -31,17 +70,6 @@ void vf_view_squash(const vf_view_bounds *bounds, const double u[VF_VIEW_DIM],
 {
     for (int i = 0; i < VF_VIEW_DIM; i++)
         v[i] = view_half_range(bounds, i) * tanh(u[i]) + view_centre(bounds, i);
-}
-
-void vf_view_unsquash(const vf_view_bounds *bounds, const double v[VF_VIEW_DIM],
-                      double u[VF_VIEW_DIM])
-{
-    for (int i = 0; i < VF_VIEW_DIM; i++) {
-        double t = (v[i] - view_centre(bounds, i)) / view_half_range(bounds, i);
-        double limit = 1.0 - 2e-9;
-        t = t < -limit ? -limit : t > limit ? limit : t;
-        u[i] = atanh(t);
-    }
 }
 
 /* ---- quadrature for E[f(eps)], eps ~ N(0, 1) ----

@@ -1,19 +1,20 @@
 /* VF_ATTACK_PEPG: the reference code's optimizer (Sehnke et al.'s parameter-exploring policy
- * gradients), one Gaussian only.
+ * gradients as in estool, with ViewFool's settings), one Gaussian only.
  *
- * Each step draws n = k/2 normal vectors eps_j and evaluates the antithetic pair
- * u = mu +- sigma * eps_j. The 2n losses are replaced by centred ranks s in [-0.5, 0.5]
- * (lowest loss -0.5, highest +0.5), which makes the update blind to the loss scale. Then
+ * Each step evaluates k = 2n + 1 viewpoints: the mean mu itself (sample 0) and n antithetic
+ * pairs u = mu +- sigma * eps_j. The k losses are replaced by centred ranks s in [-0.5, 0.5]
+ * (lowest -0.5, highest +0.5), which makes the update blind to the loss scale; the mean's rank
+ * s_0 is the baseline. Then
  *
- *     g_mu    = sum_j (s+_j - s-_j) / 2 * sigma * eps_j                 (summed over pairs)
- *     g_sigma = (1/n) sum_j (s+_j + s-_j) / 2 * sigma (eps_j^2 - 1) / std(s)
+ *     g_mu    = sum_j (s+_j - s-_j) sigma eps_j                     + lambda dH/dmu
+ *     g_sigma = sum_j ((s+_j + s-_j) / 2 - s_0) sigma (eps_j^2 - 1) / (2n) + lambda dH/dsigma
  *
- * (the mean rank is 0, so no baseline is needed). mu follows momentum SGD,
- * velocity = momentum * velocity + (1 - momentum) * g_mu, mu += lr * lr_decay^t * velocity;
- * sigma += sigma_lr * g_sigma with the change clipped to +-20% of sigma, then sigma is clipped
- * to [sigma_min, sigma_max]. With lambda > 0 the natural-gradient entropy terms
- * lambda * sigma^2 dH/dmu and lambda * sigma^2 / 2 dH/dsigma are added (on the rank scale, so
- * lambda is not comparable with NES's). v* is the best sample of the last step. */
+ * (the plain entropy gradient, on the rank scale). mu follows momentum SGD: velocity =
+ * momentum * velocity + (1 - momentum) * g_mu, mu += lr * lr_decay^t * velocity. sigma moves
+ * by sigma_lr * g_sigma with the change clipped to +-20% of sigma, is clipped to
+ * [sigma_min, sigma_max] (the reference: [0, 0.15]), and then decays by sigma_decay where it
+ * exceeds 0.01. The reference reports the best sample of the last step (the mean included) as
+ * its v*: vf_attack_v_best. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -54,10 +55,12 @@ static vf_status centred_ranks(const double *losses, int n, double *shaped)
     return VF_OK;
 }
 
+/* views[0] = the mean, views[1..n] = mu + sigma eps, views[n+1..2n] = mu - sigma eps. */
 static void pepg_sample(vf_attack_state *st, const vf_attack_config *cfg, int pairs,
                         double *eps, double *views)
 {
     vf_rng *rng = &st->rng;
+    vf_view_squash(&cfg->bounds, st->mu[0], views);
     for (int j = 0; j < pairs; j++) {
         double *e = eps + j * VF_VIEW_DIM, up[VF_VIEW_DIM], um[VF_VIEW_DIM];
         for (int i = 0; i < VF_VIEW_DIM; i++) {
@@ -65,38 +68,34 @@ static void pepg_sample(vf_attack_state *st, const vf_attack_config *cfg, int pa
             up[i] = st->mu[0][i] + st->sigma[0][i] * e[i];
             um[i] = st->mu[0][i] - st->sigma[0][i] * e[i];
         }
-        vf_view_squash(&cfg->bounds, up, views + j * VF_VIEW_DIM);
-        vf_view_squash(&cfg->bounds, um, views + (pairs + j) * VF_VIEW_DIM);
+        vf_view_squash(&cfg->bounds, up, views + (1 + j) * VF_VIEW_DIM);
+        vf_view_squash(&cfg->bounds, um, views + (1 + pairs + j) * VF_VIEW_DIM);
     }
 }
 
-/* g_mu and g_sigma from the shaped fitness (plus the entropy terms when lambda > 0). */
+/* g_mu and g_sigma from the shaped fitness, plus the entropy terms. */
 static void pepg_gradient(const vf_attack_state *st, const vf_attack_config *cfg, int pairs,
                           const double *eps, const double *shaped, double g_mu[VF_VIEW_DIM],
                           double g_sigma[VF_VIEW_DIM])
 {
-    double var = 0.0;
-    for (int j = 0; j < 2 * pairs; j++)
-        var += shaped[j] * shaped[j] / (2 * pairs);
-    double inv_std = var > 0 ? 1.0 / sqrt(var) : 0.0;
-    const double *sigma = st->sigma[0];
+    const double *sigma = st->sigma[0], *plus = shaped + 1, *minus = shaped + 1 + pairs;
+    double baseline = shaped[0];
     memset(g_mu, 0, VF_VIEW_DIM * sizeof *g_mu);
     memset(g_sigma, 0, VF_VIEW_DIM * sizeof *g_sigma);
     for (int j = 0; j < pairs; j++) {
-        double diff = 0.5 * (shaped[j] - shaped[pairs + j]);
-        double avg = 0.5 * (shaped[j] + shaped[pairs + j]);
+        double diff = plus[j] - minus[j], avg = 0.5 * (plus[j] + minus[j]) - baseline;
         for (int i = 0; i < VF_VIEW_DIM; i++) {
             double e = eps[j * VF_VIEW_DIM + i];
             g_mu[i] += diff * sigma[i] * e;
-            g_sigma[i] += avg * sigma[i] * (e * e - 1.0) * inv_std / pairs;
+            g_sigma[i] += avg * sigma[i] * (e * e - 1.0) / (2.0 * pairs);
         }
     }
     if (cfg->lambda != 0.0) {
         double h_mu[VF_VIEW_DIM], h_sigma[VF_VIEW_DIM];
         vf_squashed_entropy(&cfg->bounds, st->mu[0], sigma, h_mu, h_sigma);
         for (int i = 0; i < VF_VIEW_DIM; i++) {
-            g_mu[i] += cfg->lambda * sigma[i] * sigma[i] * h_mu[i];
-            g_sigma[i] += cfg->lambda * 0.5 * sigma[i] * sigma[i] * h_sigma[i];
+            g_mu[i] += cfg->lambda * h_mu[i];
+            g_sigma[i] += cfg->lambda * h_sigma[i];
         }
     }
 }
@@ -111,14 +110,15 @@ static void pepg_update(vf_attack_state *st, const vf_attack_config *cfg,
         st->mu[0][i] = clamp(st->mu[0][i] + lr * *velocity, -MU_LIMIT, MU_LIMIT);
         double s = st->sigma[0][i];
         double change = clamp(cfg->sigma_lr * g_sigma[i], -0.2 * s, 0.2 * s);
-        st->sigma[0][i] = clamp(s + change, cfg->sigma_min, cfg->sigma_max);
+        s = clamp(s + change, cfg->sigma_min, cfg->sigma_max);
+        st->sigma[0][i] = s > 0.01 ? fmax(s * cfg->sigma_decay, cfg->sigma_min) : s;
     }
 }
 
 vf_status pepg_step(vf_attack_state *st, const vf_attack_config *cfg, vf_attack_loss_fn loss_fn,
                     void *ctx)
 {
-    int pairs = cfg->samples / 2, k = 2 * pairs;
+    int pairs = (cfg->samples - 1) / 2, k = 2 * pairs + 1;
     double *eps = malloc((size_t)pairs * VF_VIEW_DIM * sizeof *eps);
     double *views = malloc((size_t)k * VF_VIEW_DIM * sizeof *views);
     double *losses = malloc((size_t)k * sizeof *losses);

@@ -22,13 +22,9 @@ void vf_attack_component_view(const vf_attack_state *st, const vf_attack_config 
     vf_view_squash(&cfg->bounds, st->mu[c], v);
 }
 
-void vf_attack_best_view(const vf_attack_state *st, const vf_attack_config *cfg,
-                         double v[VF_VIEW_DIM])
+void vf_attack_v_star(const vf_attack_state *st, const vf_attack_config *cfg,
+                      double v[VF_VIEW_DIM])
 {
-    if (cfg->method == VF_ATTACK_PEPG && st->step > 0) {
-        memcpy(v, st->last_best_view, VF_VIEW_DIM * sizeof *v);
-        return;
-    }
     double w[VF_ATTACK_MAX_COMPONENTS];
     vf_attack_weights(st, w);
     int heaviest = 0;
@@ -36,6 +32,11 @@ void vf_attack_best_view(const vf_attack_state *st, const vf_attack_config *cfg,
         if (w[c] > w[heaviest])
             heaviest = c;
     vf_attack_component_view(st, cfg, heaviest, v);
+}
+
+void vf_attack_v_best(const vf_attack_state *st, double v[VF_VIEW_DIM])
+{
+    memcpy(v, st->last_best_view, VF_VIEW_DIM * sizeof *v);
 }
 
 void vf_attack_sample_views(const vf_attack_state *st, const vf_attack_config *cfg,
@@ -74,14 +75,22 @@ void vf_view_std(const double *views, int n, double std[VF_VIEW_DIM])
     }
 }
 
-void vf_view_fluctuation(const vf_view_bounds *bounds, const double centre[VF_VIEW_DIM],
+void vf_view_fluctuation(const vf_view_bounds *search, const double centre[VF_VIEW_DIM],
                          double r_percent, vf_rng *rng, int n, double *views)
 {
+    double range[VF_VIEW_DIM];
+    vf_view_bounds clip;
+    vf_view_ranges_paper(range);
+    vf_view_bounds_default(&clip);
+    for (int i = 0; i < VF_VIEW_DIM; i++) {
+        clip.lo[i] = fmin(clip.lo[i], search->lo[i]);
+        clip.hi[i] = fmax(clip.hi[i], search->hi[i]);
+    }
     for (int j = 0; j < n; j++)
         for (int i = 0; i < VF_VIEW_DIM; i++) {
-            double half = r_percent / 100.0 * (bounds->hi[i] - bounds->lo[i]);
+            double half = r_percent / 100.0 * range[i];
             double v = centre[i] + half * (2.0 * vf_rng_uniform(rng) - 1.0);
-            views[j * VF_VIEW_DIM + i] = clamp(v, bounds->lo[i], bounds->hi[i]);
+            views[j * VF_VIEW_DIM + i] = clamp(v, clip.lo[i], clip.hi[i]);
         }
 }
 

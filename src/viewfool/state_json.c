@@ -10,7 +10,7 @@
 
 #include "viewfool_internal.h"
 
-#define STATE_FORMAT 1
+#define STATE_FORMAT 2 /* 2: moments over (mu, sigma), not (mu, log sigma) */
 
 /* ---- small converters ---- */
 
@@ -218,8 +218,8 @@ json_t *vf_attack_config_to_json(const vf_attack_config *cfg)
         cfg->method == VF_ATTACK_PEPG ? "pepg" : "nes", "bounds", bounds, "samples", cfg->samples,
         "steps", cfg->steps, "lambda", cfg->lambda, "lr", cfg->lr, "seed", seed, "sigma_init",
         cfg->sigma_init, "sigma_min", cfg->sigma_min, "sigma_max", cfg->sigma_max);
-    json_t *more = json_pack("{s:b, s:b, s:i, s:f, s:f, s:f, s:f, s:f, s:f}", "natural_gradient",
-                             cfg->natural_gradient, "antithetic", cfg->antithetic, "components",
+    json_t *more = json_pack("{s:f, s:b, s:i, s:f, s:f, s:f, s:f, s:f, s:f}", "sigma_decay",
+                             cfg->sigma_decay, "antithetic", cfg->antithetic, "components",
                              cfg->components, "weight_lr", cfg->weight_lr, "adam_beta1",
                              cfg->adam_beta1, "adam_beta2", cfg->adam_beta2, "momentum",
                              cfg->momentum, "lr_decay", cfg->lr_decay, "sigma_lr", cfg->sigma_lr);
@@ -281,7 +281,7 @@ vf_status vf_attack_config_from_json(const json_t *json, vf_attack_config *cfg)
         (s = config_real(json, "sigma_init", &cfg->sigma_init)) ||
         (s = config_real(json, "sigma_min", &cfg->sigma_min)) ||
         (s = config_real(json, "sigma_max", &cfg->sigma_max)) ||
-        (s = config_int(json, "natural_gradient", &cfg->natural_gradient)) ||
+        (s = config_real(json, "sigma_decay", &cfg->sigma_decay)) ||
         (s = config_int(json, "antithetic", &cfg->antithetic)) ||
         (s = config_int(json, "components", &cfg->components)) ||
         (s = config_real(json, "weight_lr", &cfg->weight_lr)) ||

@@ -27,7 +27,7 @@ static inline double clamp(double x, double lo, double hi)
 
 /* Index of a component's parameters in the moment arrays and gradients. */
 static inline int param_mu(int c, int i) { return c * VF_ATTACK_COMPONENT_PARAMS + i; }
-static inline int param_log_sigma(int c, int i)
+static inline int param_sigma(int c, int i)
 {
     return c * VF_ATTACK_COMPONENT_PARAMS + VF_VIEW_DIM + i;
 }
