@@ -7,6 +7,9 @@
  *   transforms     vf_dataset_load (NeRF transforms.json; a 4x4 image "a.png" exists beside it)
  *   colmap_text    vf_colmap_model_load (cameras.txt, images.txt, points3D.txt split at "\n@@\n")
  *   field_model    vf_field_load, then a 24x24 render of what loaded
+ *   checkpoint     vf_field_trainer_resume on a trainer holding two fixed 8x8 views (the seed
+ *                  is a checkpoint of those views: VF_FUZZ_MAKE_SEED=FILE writes one), then a
+ *                  training step
  *   onnx           vf_onnx_input_dims (the ONNX shape walker)
  *   manifest       vf_workspace_open (WS/manifest.json)
  *   attack_json    vf_attack_file_load (WS/attack/attack.json)
@@ -34,6 +37,15 @@
 #endif
 
 static char dir[256]; /* this process's scratch folder */
+
+static void make_checkpoint_seed(const char *path);
+
+/* A set-up step of the harness itself failed (not the loader under test). */
+static void die(const char *what)
+{
+    fprintf(stderr, "fuzz harness: %s: %s\n", what, vf_error_message());
+    abort();
+}
 
 static void write_bytes(const char *name, const uint8_t *data, size_t size)
 {
@@ -76,6 +88,9 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     vf_mkdirs(sub);
     snprintf(sub, sizeof sub, "%s/export", dir);
     vf_mkdirs(sub);
+    const char *seed = getenv("VF_FUZZ_MAKE_SEED");
+    if (seed && !strcmp(VF_FUZZ_FORMAT, "checkpoint"))
+        make_checkpoint_seed(seed);
     return 0;
 }
 
@@ -97,6 +112,59 @@ static void colmap_text(const uint8_t *data, size_t size)
     vf_colmap_model m;
     if (vf_colmap_model_load(dir, &m) == VF_OK)
         vf_colmap_model_free(&m);
+}
+
+/* A small trainer over two fixed synthetic views; the checkpoint target resumes it. */
+static vf_field_trainer *small_trainer(void)
+{
+    vf_field_train_options opt;
+    vf_field_train_defaults(&opt);
+    opt.seconds = 0;
+    opt.steps = 8;
+    opt.batch_rays = 64;
+    opt.max_points = 12 * 12 * 12;
+    opt.levels = 1;
+    opt.threads = 1;
+    vf_field_trainer *t;
+    if (vf_field_trainer_create(&opt, &t) != VF_OK)
+        die("trainer");
+    vf_camera cam = {.width = 8, .height = 8, .fx = 10, .fy = 10, .cx = 4, .cy = 4};
+    for (int k = 0; k < 2; k++) {
+        vf_viewpoint v = {.psi = 40.0 * k, .phi = 120};
+        double c2w[16];
+        vf_viewpoint_to_c2w(&v, c2w);
+        vf_image img;
+        if (vf_image_alloc(&img, 8, 8, 3) != VF_OK)
+            abort();
+        for (int i = 0; i < 8 * 8 * 3; i++)
+            img.data[i] = (float)((i * 7 + k * 3) % 11) / 10.0f;
+        if (vf_field_trainer_add_view(t, &cam, c2w, &img) != VF_OK)
+            die("view");
+        vf_image_free(&img);
+    }
+    return t;
+}
+
+static void checkpoint(const uint8_t *data, size_t size)
+{
+    write_bytes("train.vfc", data, size);
+    vf_field_trainer *t = small_trainer();
+    vf_field_train_status st;
+    if (vf_field_trainer_resume(t, path_of("train.vfc")) == VF_OK)
+        vf_field_trainer_step(t, &st);
+    vf_field_trainer_free(t);
+}
+
+/* VF_FUZZ_MAKE_SEED=FILE: write the checkpoint target's seed (two steps of small_trainer). */
+static void make_checkpoint_seed(const char *path)
+{
+    vf_field_trainer *t = small_trainer();
+    vf_field_train_status st;
+    if (vf_field_trainer_start(t) != VF_OK || vf_field_trainer_step(t, &st) != VF_OK ||
+        vf_field_trainer_step(t, &st) != VF_OK || vf_field_trainer_save_checkpoint(t, path) != VF_OK)
+        die("seed");
+    vf_field_trainer_free(t);
+    exit(0);
 }
 
 static void field_model(const uint8_t *data, size_t size)
@@ -125,6 +193,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         colmap_text(data, size);
     } else if (!strcmp(format, "field_model")) {
         field_model(data, size);
+    } else if (!strcmp(format, "checkpoint")) {
+        checkpoint(data, size);
     } else if (!strcmp(format, "onnx")) {
         long long dims[8];
         vf_onnx_input_dims(data, size, dims, 8);
