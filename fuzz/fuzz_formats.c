@@ -119,12 +119,9 @@ static vf_field_trainer *small_trainer(void)
 {
     vf_field_train_options opt;
     vf_field_train_defaults(&opt);
-    opt.seconds = 0;
-    opt.steps = 8;
-    opt.batch_rays = 64;
-    opt.max_points = 12 * 12 * 12;
-    opt.levels = 1;
-    opt.threads = 1;
+    opt.seconds = 0, opt.steps = 8;          /* a step budget: the same seed every time */
+    opt.batch_rays = 64, opt.levels = 1;      /* one tiny level, one thread */
+    opt.max_points = 12 * 12 * 12, opt.threads = 1;
     vf_field_trainer *t;
     if (vf_field_trainer_create(&opt, &t) != VF_OK)
         die("trainer");
