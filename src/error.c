@@ -8,10 +8,14 @@ static _Thread_local char error_text[1024];
 
 vf_status vf_fail(vf_status code, const char *fmt, ...)
 {
+    /* formatted aside first: an argument may be vf_error_message() itself, as in
+     * vf_fail(s, "%s; and then ...", vf_error_message()) */
+    char text[sizeof error_text];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(error_text, sizeof error_text, fmt, ap);
+    vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
+    memcpy(error_text, text, sizeof error_text);
     return code;
 }
 

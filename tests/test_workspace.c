@@ -40,9 +40,19 @@ static void test_json_round_trip(void)
     json_decref(back);
 }
 
+/* A message may build on the one before it (the commit's recovery messages do). */
+static void test_error_chaining(void)
+{
+    vf_fail(VF_EINPUT, "cannot write X");
+    vf_fail(VF_EINTERNAL, "%s; the previous output is in %s", vf_error_message(), "Y");
+    CHECK(!strcmp(vf_error_message(), "cannot write X; the previous output is in Y"),
+          "chained message: %s", vf_error_message());
+}
+
 int main(void)
 {
     test_json_round_trip();
+    test_error_chaining();
     char root[VF_PATH_MAX], path[VF_PATH_MAX];
     vf_path_join(root, sizeof root, vf_test_tmpdir(), "ws");
     vf_workspace ws;

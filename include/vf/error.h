@@ -18,7 +18,8 @@ typedef enum {
     VF_EINTERNAL = 2  /* something failed that the user could not have prevented */
 } vf_status;
 
-/* Record a formatted message and return code, so callers can write `return vf_fail(...)`. */
+/* Record a formatted message and return code, so callers can write `return vf_fail(...)`.
+ * The arguments may include vf_error_message() (to build on the message before). */
 vf_status vf_fail(vf_status code, const char *fmt, ...)
 #ifdef __GNUC__
     __attribute__((format(printf, 2, 3)))
