@@ -127,7 +127,7 @@ json_t *vf_attack_eval_to_json(const vf_attack_eval *ev)
     for (int i = 0; i < VF_FLUCT_LEVELS; i++)
         r[i] = i + 1;
     vf_view_ranges_paper(range);
-    json_t *doc = json_pack(
+    return json_pack(
         "{s:o, s:o, s:f, s:o, s:o, s:f, s:o, s:o, s:o, s:f, s:o, s:{s:o, s:o, s:i}, s:o}",
         "v_star", doubles_json(ev->v_star, VF_VIEW_DIM), "v_star_prediction",
         vf_view_prediction_to_json(&ev->v_star_pred), "asr_v_star", ev->asr_v_star, "v_best",
@@ -138,5 +138,4 @@ json_t *vf_attack_eval_to_json(const vf_attack_eval *ev)
         doubles_json(ev->sample_std, VF_VIEW_DIM), "fluctuation", "r_percent",
         doubles_json(r, VF_FLUCT_LEVELS), "asr", doubles_json(ev->fluct_asr, VF_FLUCT_LEVELS),
         "samples_per_level", VF_FLUCT_SAMPLES, "top_wrong_classes", wrong);
-    return doc;
 }
