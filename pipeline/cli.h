@@ -67,5 +67,6 @@ int cmd_localize(int argc, char **argv);
 int cmd_score(int argc, char **argv);
 int cmd_export(int argc, char **argv);
 int cmd_reshoot(int argc, char **argv);
+int cmd_real(int argc, char **argv);
 
 #endif

@@ -2,7 +2,8 @@
  *
  * From a capture (a video file, a folder of photos or a V4L2 webcam) the sharpest distinct
  * frames, spread over the capture, go to WS/ingest/images/ with WS/ingest/report.json
- * (vf/ingest.h does the work). A posed dataset (NeRF transforms.json) is imported as it is:
+ * (vf/ingest.h does the work). A 3D model is rendered by Blender into a posed set, the
+ * paper's capture (vf/object3d.h). A posed dataset (NeRF transforms.json) is imported as it is:
  * every image is decoded once to check it, copied into WS/ingest/images/, and listed with its
  * camera in WS/ingest/transforms.json, so later stages never depend on the original folder. */
 #define _GNU_SOURCE
@@ -19,12 +20,14 @@
 #include "vf/image.h"
 #include "vf/ingest.h"
 #include "vf/log.h"
+#include "vf/object3d.h"
 #include "vf/workspace.h"
 
 static const char usage[] =
     "usage: vfcapture ingest VIDEO|PHOTO_FOLDER -o WS [options]\n"
     "       vfcapture ingest --v4l2 /dev/videoN -o WS [--seconds S] [--size WxH] [options]\n"
     "       vfcapture ingest --transforms FILE -o WS [options]\n"
+    "       vfcapture ingest MODEL.glb|.gltf|.obj|.blend -o WS [--views N] [--render-size PX]\n"
     "\n"
     "Bring a capture of an object into the workspace WS (created when missing).\n"
     "From a video (anything FFmpeg plays; phone rotation is applied), a folder of JPEG/PNG\n"
@@ -32,6 +35,11 @@ static const char usage[] =
     "spread evenly over the capture, are written to WS/ingest/images/; blurry frames and\n"
     "near-duplicates are left out. WS/ingest/report.json says what was kept and why.\n"
     "A posed image set (NeRF transforms.json) is imported whole, with its cameras.\n"
+    "A 3D model is rendered by Blender (Cycles, every core) as the ViewFool paper's capture:\n"
+    "views on the upper hemisphere at distance 4 with the NeRF-synthetic camera, transparent\n"
+    "background, plus held-out test views (WS/ingest/transforms_test.json); the model is\n"
+    "centred and scaled into the unit sphere, and WS/ingest/object.json records how. An\n"
+    "interrupted model ingest continues where it stopped when run again.\n"
     "\n"
     "options:\n"
     "  -o, --output WS        workspace folder (required)\n"
@@ -47,7 +55,14 @@ static const char usage[] =
     "      --seconds S        webcam: capture for S seconds (default 10)\n"
     "      --size WxH         webcam: frame size to ask for (default 1280x720)\n"
     "      --pixel-format F   webcam: mjpeg or yuyv, used when offered (default mjpeg)\n"
-    "  -t, --transforms FILE  import a posed dataset instead\n" CLI_COMMON_HELP;
+    "  -t, --transforms FILE  import a posed dataset instead\n"
+    "      --views N          model: training views (default 100)\n"
+    "      --test-views N     model: held-out views (default 25)\n"
+    "      --render-size PX   model: side of the square renders (default 200, as\n"
+    "                         NeRF-synthetic)\n"
+    "      --samples N        model: Cycles samples a pixel (default 32)\n"
+    "      --seed S           model: where on the hemisphere the views are (default 0)\n"
+    CLI_COMMON_HELP;
 
 typedef struct ingest_options {
     const char *source;     /* video file or photo folder */
@@ -55,6 +70,7 @@ typedef struct ingest_options {
     const char *transforms; /* --transforms */
     const char *workspace;
     vf_ingest_options capture;
+    vf_object3d_capture model; /* a 3D model's capture */
     cli_flags flags;
 } ingest_options;
 
@@ -66,6 +82,11 @@ enum {
     OPT_SECONDS,
     OPT_SIZE,
     OPT_PIXEL_FORMAT,
+    OPT_VIEWS,
+    OPT_TEST_VIEWS,
+    OPT_RENDER_SIZE,
+    OPT_SAMPLES,
+    OPT_SEED,
 };
 
 /* Parse "WxH". */
@@ -86,6 +107,34 @@ static vf_status parse_number(const char *text, const char *option, double lo, d
         return vf_fail(VF_EINPUT, "%s wants a number from %g to %g, not '%s'", option, lo, hi,
                        text);
     *out = value;
+    return VF_OK;
+}
+
+/* Apply one of the options of a model's capture. */
+static vf_status apply_model_option(int c, const char *arg, vf_object3d_capture *m)
+{
+    static const struct {
+        int option;
+        const char *name;
+        long lo, hi;
+    } limits[] = {{OPT_VIEWS, "--views", 3, 10000},
+                  {OPT_TEST_VIEWS, "--test-views", 0, 10000},
+                  {OPT_RENDER_SIZE, "--render-size", 16, 4096},
+                  {OPT_SAMPLES, "--samples", 1, 65536},
+                  {OPT_SEED, "--seed", 0, LONG_MAX}};
+    for (size_t i = 0; i < sizeof limits / sizeof limits[0]; i++) {
+        long n;
+        if (limits[i].option != c)
+            continue;
+        if (cli_parse_int(arg, limits[i].lo, limits[i].hi, &n))
+            return vf_fail(VF_EINPUT, "%s wants a whole number from %ld to %ld, not '%s'",
+                           limits[i].name, limits[i].lo, limits[i].hi, arg);
+        int *field[] = {&m->views, &m->test_views, &m->size, &m->samples};
+        if (c == OPT_SEED)
+            m->seed = (uint64_t)n;
+        else
+            *field[i] = (int)n;
+    }
     return VF_OK;
 }
 
@@ -130,6 +179,12 @@ static vf_status apply_option(int c, const char *arg, ingest_options *opt)
         if (parse_size(arg, &cap->width, &cap->height))
             return vf_fail(VF_EINPUT, "--size wants WIDTHxHEIGHT, e.g. 1280x720, not '%s'", arg);
         return VF_OK;
+    case OPT_VIEWS:
+    case OPT_TEST_VIEWS:
+    case OPT_RENDER_SIZE:
+    case OPT_SAMPLES:
+    case OPT_SEED:
+        return apply_model_option(c, arg, &opt->model);
     case OPT_PIXEL_FORMAT:
         if (!strcasecmp(arg, "mjpeg") || !strcasecmp(arg, "mjpg"))
             cap->pixel_format = V4L2_PIX_FMT_MJPEG;
@@ -157,9 +212,15 @@ static int parse_options(int argc, char **argv, ingest_options *opt)
         {"seconds", required_argument, NULL, OPT_SECONDS},
         {"size", required_argument, NULL, OPT_SIZE},
         {"pixel-format", required_argument, NULL, OPT_PIXEL_FORMAT},
+        {"views", required_argument, NULL, OPT_VIEWS},
+        {"test-views", required_argument, NULL, OPT_TEST_VIEWS},
+        {"render-size", required_argument, NULL, OPT_RENDER_SIZE},
+        {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"seed", required_argument, NULL, OPT_SEED},
         {0, 0, 0, 0},
     };
     vf_ingest_defaults(&opt->capture);
+    vf_object3d_capture_defaults(&opt->model);
     int c;
     while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "t:o:n:", longopts, NULL)) != -1) {
         if (cli_common_option(c, &opt->flags, "ingest", usage))
@@ -177,7 +238,8 @@ static int parse_options(int argc, char **argv, ingest_options *opt)
         return vf_fail(VF_EINPUT, "give one source: a video file, a photo folder, --v4l2 DEVICE "
                                   "or --transforms FILE");
     if (opt->source && !vf_is_file(opt->source) && !vf_is_dir(opt->source))
-        return vf_fail(VF_EINPUT, "%s does not exist; give a video file or a folder of photos",
+        return vf_fail(VF_EINPUT, "cannot read %s: no such file; give a video file, a folder "
+                                  "of photos or a 3D model (.glb, .gltf, .obj, .blend)",
                        opt->source);
     if (!opt->workspace)
         return vf_fail(VF_EINPUT, "give the workspace folder with -o WS");
@@ -346,12 +408,29 @@ static vf_status import_capture(const ingest_options *opt, const char *stage_dir
     return status;
 }
 
+/* Render a 3D model's capture into the staging folder. */
+static vf_status import_model(const ingest_options *opt, const char *stage_dir, json_t **params,
+                              json_t **summary)
+{
+    const vf_object3d_capture *m = &opt->model;
+    vf_info("%s: rendering %d + %d views of %dx%d with Blender (%d samples)", opt->source,
+            m->views, m->test_views, m->size, m->size, m->samples);
+    vf_status status = vf_object3d_ingest(opt->source, m, stage_dir, summary);
+    if (status == VF_OK)
+        *params = json_pack("{s:s, s:O, s:i, s:i, s:i, s:i, s:I}", "source", "model", "input",
+                            json_object_get(*summary, "input"), "views", m->views, "test_views",
+                            m->test_views, "size", m->size, "samples", m->samples, "seed",
+                            (json_int_t)m->seed);
+    return status;
+}
+
 typedef vf_status (*import_fn)(const ingest_options *opt, const char *stage_dir,
                                json_t **params, json_t **summary);
 
 /* Run an import in the workspace's staging folder and swap it in when it succeeds. A
  * workspace this run created is removed again when it fails, so bad input leaves nothing
- * behind, and an existing one keeps its earlier outputs. */
+ * behind, and an existing one keeps its earlier outputs. A model's renders are slow: when
+ * they stop half-way (interrupted, not refused) the staging folder is kept for the next run. */
 static vf_status run_in_stage(const ingest_options *opt, import_fn import, json_t **summary_out)
 {
     vf_workspace ws;
@@ -361,19 +440,26 @@ static vf_status run_in_stage(const ingest_options *opt, import_fn import, json_
     vf_status status = vf_workspace_open(opt->workspace, 1, &ws);
     if (status != VF_OK)
         return status;
-    status = vf_stage_begin(&ws, "ingest", &stage);
+    int resumable = import == import_model;
+    status = resumable ? vf_stage_resume(&ws, "ingest", &stage)
+                       : vf_stage_begin(&ws, "ingest", &stage);
     if (status == VF_OK)
         status = import(opt, stage.dir, &params, &summary);
+    char first[VF_PATH_MAX]; /* renders made so far stay for a retry */
+    int keep = resumable && status == VF_EINTERNAL &&
+               vf_path_join(first, sizeof first, stage.dir, "images/r_000.png") == VF_OK &&
+               vf_is_file(first);
     if (status == VF_OK) {
         *summary_out = json_deep_copy(summary);
         status = vf_stage_commit(&stage, params, summary);
     } else {
         json_decref(params);
         json_decref(summary);
-        vf_stage_abort(&stage);
+        if (!keep)
+            vf_stage_abort(&stage);
     }
     vf_workspace_close(&ws);
-    if (status != VF_OK && fresh)
+    if (status != VF_OK && fresh && !keep)
         vf_remove_tree(opt->workspace);
     return status;
 }
@@ -388,7 +474,12 @@ static void print_result(const ingest_options *opt, json_t *summary)
     long long frames = json_integer_value(json_object_get(summary, "frames"));
     long long width = json_integer_value(json_object_get(summary, "width"));
     long long height = json_integer_value(json_object_get(summary, "height"));
-    if (opt->transforms)
+    if (!strcmp(json_string_value(json_object_get(summary, "source")) ?: "", "model"))
+        printf("rendered %lld + %lld views (%lldx%lld) of %s in %.0f s into %s/ingest\n", frames,
+               json_integer_value(json_object_get(summary, "test_frames")), width, height,
+               opt->source, json_number_value(json_object_get(summary, "seconds")),
+               opt->workspace);
+    else if (opt->transforms)
         printf("imported %lld frames (%lldx%lld, %s background) into %s/ingest\n", frames, width,
                height, json_string_value(json_object_get(summary, "background")), opt->workspace);
     else
@@ -407,7 +498,11 @@ int cmd_ingest(int argc, char **argv)
     vf_status status = parse_options(argc, argv, &opt);
     json_t *summary = NULL;
     if (status == VF_OK)
-        status = run_in_stage(&opt, opt.transforms ? import_transforms : import_capture, &summary);
+        status = run_in_stage(&opt,
+                              opt.transforms                                 ? import_transforms
+                              : opt.source && vf_object3d_is_model(opt.source) ? import_model
+                                                                               : import_capture,
+                              &summary);
     if (status != VF_OK)
         return cli_fail("ingest", status);
     print_result(&opt, summary);

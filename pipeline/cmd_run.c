@@ -11,15 +11,17 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "vf/object3d.h"
 #include "vf/fsutil.h"
 #include "vf/log.h"
 #include "vf/workspace.h"
 
 static const char usage[] =
-    "usage: vfcapture run VIDEO|PHOTO_FOLDER|TRANSFORMS_JSON -o WS [options]\n"
+    "usage: vfcapture run VIDEO|PHOTO_FOLDER|TRANSFORMS_JSON|MODEL.glb -o WS [options]\n"
     "\n"
     "Run the whole pipeline on one capture: ingest, poses (COLMAP; skipped for a posed\n"
-    "transforms.json), train, attack and export. Stages whose output is already in WS with the\n"
+    "transforms.json or a 3D model), train, attack, real (a 3D model only: the attack's\n"
+    "viewpoints on the model itself) and export. Stages whose output is already in WS with the\n"
     "same settings are kept; the first missing or changed stage and every stage after it run.\n"
     "Ends with a summary and the paths of the shot card and the attack report. When a stage\n"
     "fails, fix what its message says and run the same command again to continue.\n"
@@ -83,15 +85,18 @@ static int plan_stages(const run_options *opt, stage_call *calls)
     stage_call *c = &calls[n++];
     *c = (stage_call){.name = "ingest", .run = cmd_ingest};
     push(c, "ingest");
+    int model = vf_object3d_is_model(opt->input); /* posed by Blender; checked by `real` */
     if (is_transforms_file(opt->input)) {
         push_option(c, "--transforms", opt->input);
+    } else if (model) {
+        push(c, opt->input);
     } else {
         push(c, opt->input);
         push_option(c, "--frames", opt->frames);
     }
     push_option(c, "--output", opt->workspace);
 
-    if (!is_transforms_file(opt->input)) {
+    if (!is_transforms_file(opt->input) && !model) {
         c = &calls[n++];
         *c = (stage_call){.name = "poses", .run = cmd_poses};
         push(c, "poses");
@@ -113,6 +118,13 @@ static int plan_stages(const run_options *opt, stage_call *calls)
     push_option(c, "--label", opt->label);
     push_option(c, "--samples", opt->samples);
     push_option(c, "--steps", opt->steps);
+
+    if (model) {
+        c = &calls[n++];
+        *c = (stage_call){.name = "real", .run = cmd_real};
+        push(c, "real");
+        push(c, opt->workspace);
+    }
 
     c = &calls[n++];
     *c = (stage_call){.name = "export", .run = cmd_export};
@@ -182,7 +194,7 @@ static vf_status parse_options(int argc, char **argv, run_options *opt)
         }
     }
     if (optind != argc - 1)
-        return vf_fail(VF_EINPUT, "give one video, photo folder or transforms.json "
+        return vf_fail(VF_EINPUT, "give one video, photo folder, transforms.json or 3D model "
                                   "(see 'vfcapture run --help')");
     opt->input = argv[optind];
     if (!opt->workspace)
@@ -246,7 +258,7 @@ int cmd_run(int argc, char **argv)
     if (status != VF_OK)
         return cli_fail("run", status);
 
-    stage_call calls[5];
+    stage_call calls[6];
     int count = plan_stages(&opt, calls);
     char memory_path[VF_PATH_MAX];
     vf_workspace ws;

@@ -7,12 +7,13 @@
 
 static const cli_command commands[] = {
     {"run", cmd_run, "the whole pipeline on one capture: ingest, poses, train, attack, export"},
-    {"ingest", cmd_ingest, "bring a capture into a workspace (video, photos, webcam or posed set)"},
+    {"ingest", cmd_ingest, "bring a capture into a workspace (video, photos, webcam, posed set, 3D model)"},
     {"poses", cmd_poses, "camera poses by structure from motion (COLMAP), in the object frame"},
     {"train", cmd_train, "fit a radiance field to the posed images (CPU, minutes)"},
     {"render", cmd_render, "render the trained field from a viewpoint or camera pose"},
     {"eval", cmd_eval, "PSNR/SSIM of the trained field on a posed test set"},
     {"attack", cmd_attack, "ViewFool: adversarial viewpoint distribution on the trained field"},
+    {"real", cmd_real, "check the attack's viewpoints on the 3D model itself (Real(v*))"},
     {"transfer", cmd_transfer, "success rate of an attack's sampled viewpoints on other models"},
     {"export", cmd_export, "target shots for the attack's viewpoints: poses, words, previews, card"},
     {"localize", cmd_localize, "where was this frame taken? poses of new photos or video frames"},

@@ -9,6 +9,7 @@ packages=(
   colmap ffmpeg libavformat-dev libavcodec-dev libswscale-dev
   libopencv-dev libopenimageio-dev openimageio-tools libceres-dev libeigen3-dev
   libv4l-dev v4l-utils libjansson-dev libcairo2-dev libsqlite3-dev python3
+  blender python3-numpy
 )
 
 missing=()

@@ -27,6 +27,7 @@ extern "C" {
 #endif
 
 #define VF_NUM_CLASSES 1000
+#define VF_MAX_LABELS 32 /* classes in one label set */
 
 typedef struct vf_classifier vf_classifier;
 

@@ -1,13 +1,12 @@
 /* vf/colmap.h: running COLMAP's command-line tools as child processes.
  *
  * COLMAP (the `colmap` program, 3.8 on Debian) does feature extraction, matching and
- * structure from motion. vfcapture runs it as a child process (posix_spawn, never a shell),
+ * structure from motion. vfcapture runs it as a child process (vf/process.h: never a shell),
  * appends everything it prints to one log file, and turns the counts it prints ("Processed file
  * [3/50]", "Registering image #7 (12)") into a progress line. The program is `colmap` from PATH,
  * or $VF_COLMAP when set.
  *
- * Memory: a vf_args owns its strings (vf_args_free); a vf_colmap owns its open log file
- * (vf_colmap_close). */
+ * Memory: a vf_colmap owns its open log file (vf_colmap_close). */
 #ifndef VF_COLMAP_H
 #define VF_COLMAP_H
 
@@ -15,27 +14,11 @@
 
 #include "vf/error.h"
 #include "vf/fsutil.h"
+#include "vf/process.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* A growing, NULL-terminated argument vector. */
-typedef struct vf_args {
-    char **items;
-    int count, capacity;
-} vf_args;
-
-/* Append one argument (copied). Out-of-memory is remembered and reported by vf_colmap_run. */
-void vf_args_add(vf_args *args, const char *item);
-/* Append "--name" and its formatted value,
- * e.g. vf_args_opt(a, "--Mapper.ba_refine_focal_length", "%d", 0). */
-void vf_args_opt(vf_args *args, const char *name, const char *fmt, ...)
-#ifdef __GNUC__
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-void vf_args_free(vf_args *args);
 
 typedef struct vf_colmap {
     char program[VF_PATH_MAX]; /* resolved path of the colmap executable */

@@ -18,6 +18,7 @@
 #define VF_TARGETS_H
 
 #include "vf/camera.h"
+#include "vf/classifier.h"
 #include "vf/error.h"
 #include "vf/fsutil.h"
 #include "vf/pose.h"
@@ -28,8 +29,6 @@ extern "C" {
 #endif
 
 /* ---- attack.json, as far as the physical loop reads it ---- */
-
-#define VF_MAX_LABELS 64
 
 typedef struct vf_sample_prediction {
     int cls;                 /* predicted class index, -1 when unknown */

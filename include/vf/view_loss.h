@@ -35,7 +35,6 @@ extern "C" {
 #endif
 
 #define VF_VIEW_LOSS_CHUNK 16   /* views rendered and classified together */
-#define VF_MAX_LABELS 32        /* classes in one label set */
 
 typedef struct vf_view_prediction {
     int top_class;    /* top-1 ImageNet class */
@@ -70,6 +69,12 @@ vf_status vf_view_loss_classify(vf_view_loss *vl, const double *views, int n,
                                 vf_view_prediction *out, double *losses);
 vf_status vf_view_loss_classify_poses(vf_view_loss *vl, const double *c2w, int n,
                                       vf_view_prediction *out);
+
+/* Classify n images that are already the model's S x S RGB input (photos or renders of the
+ * object itself, seen with the classifier camera), scored against the label set like renders
+ * of the field. VF_EINPUT when an image has another size. */
+vf_status vf_view_loss_classify_images(vf_view_loss *vl, const vf_image *images, int n,
+                                       vf_view_prediction *out);
 
 /* The attack's loss callback (vf/viewfool.h, vf_attack_loss_fn); ctx is a vf_view_loss with
  * its labels set. */

@@ -83,14 +83,15 @@ static void predict(const vf_view_loss *vl, float *logits, vf_view_prediction *o
     out->label_prob = (float)exp(-*loss);
 }
 
-/* Classify the n (<= chunk) images already rendered into vl->images. */
-static vf_status classify_rendered(vf_view_loss *vl, int n, vf_view_prediction *out)
+/* Classify n (<= chunk) images of the model's input size. */
+static vf_status classify_chunk(vf_view_loss *vl, const vf_image *images, int n,
+                                vf_view_prediction *out)
 {
     double t0 = vf_now();
     size_t stride = 3 * (size_t)vl->size * (size_t)vl->size;
 #pragma omp parallel for
     for (int i = 0; i < n; i++)
-        vf_classifier_normalize(&vl->images[i], vl->batch + (size_t)i * stride);
+        vf_classifier_normalize(&images[i], vl->batch + (size_t)i * stride);
     vf_status status = vf_classifier_logits(vl->cls, vl->batch, n, vl->logits);
     if (status != VF_OK)
         return status;
@@ -98,6 +99,29 @@ static vf_status classify_rendered(vf_view_loss *vl, int n, vf_view_prediction *
         predict(vl, vl->logits + (size_t)i * VF_NUM_CLASSES, &out[i], &vl->losses[i]);
     vl->stats.classify_seconds += vf_now() - t0;
     vl->stats.views += n;
+    return VF_OK;
+}
+
+static vf_status classify_rendered(vf_view_loss *vl, int n, vf_view_prediction *out)
+{
+    return classify_chunk(vl, vl->images, n, out);
+}
+
+vf_status vf_view_loss_classify_images(vf_view_loss *vl, const vf_image *images, int n,
+                                       vf_view_prediction *out)
+{
+    for (int i = 0; i < n; i++)
+        if (images[i].width != vl->size || images[i].height != vl->size || images[i].channels != 3)
+            return vf_fail(VF_EINPUT, "image %d is %dx%d with %d channels, not the model's "
+                                      "%dx%d RGB",
+                           i, images[i].width, images[i].height, images[i].channels, vl->size,
+                           vl->size);
+    for (int first = 0; first < n; first += VF_VIEW_LOSS_CHUNK) {
+        int m = n - first < VF_VIEW_LOSS_CHUNK ? n - first : VF_VIEW_LOSS_CHUNK;
+        vf_status status = classify_chunk(vl, images + first, m, out + first);
+        if (status != VF_OK)
+            return status;
+    }
     return VF_OK;
 }
 

@@ -1,0 +1,122 @@
+/* vf/object3d.h: a textured 3D model as an object whose ground truth is known.
+ *
+ * The ViewFool paper's main protocol: render 100 views of a 3D model on the upper hemisphere,
+ * train the radiance field on them, attack the field, and check the adversarial viewpoints
+ * against the object itself by rendering the model there (the paper's Real(v*) column).
+ * Blender is the renderer (the NeRF-synthetic scenes were made with it); vfcapture runs it as a
+ * program, as it runs COLMAP (vf/process.h), with a Python script of its own that is built into
+ * the tool (src/object3d/blender_render.py) and written next to Blender's log when it runs.
+ *
+ * Frames. Blender's importer turns the model's axes into Blender's z-up world; the model is
+ * then centred (bounding-box centre) and scaled into the unit sphere, x_object = scale *
+ * (x_blender - center): the object frame of vf/pose.h (z up, object at the origin, cameras at
+ * distance 4), so an imported model is a posed set like any NeRF-synthetic scene and every later
+ * stage treats it so. The transform is recorded and reused, so the model rendered again later
+ * sits exactly where the field learned it.
+ *
+ * A workspace made from a model holds WS/ingest/object.json (the model file, its size, the
+ * transform and the render settings) beside the posed set: transforms.json (training views),
+ * transforms_test.json (held-out views), images/, test/, blender.log.
+ *
+ * Memory: plain structs; vf_object3d_render_images fills images the caller frees. */
+#ifndef VF_OBJECT3D_H
+#define VF_OBJECT3D_H
+
+#include <jansson.h>
+#include <stdint.h>
+
+#include "vf/camera.h"
+#include "vf/error.h"
+#include "vf/fsutil.h"
+#include "vf/image.h"
+#include "vf/workspace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define VF_OBJECT3D_FILE "object.json"      /* in WS/ingest */
+#define VF_NERF_CAMERA_ANGLE_X 0.6911112070083618 /* the NeRF-synthetic camera (radians) */
+
+/* x_object = scale * (x_blender - center). */
+typedef struct vf_object3d_transform {
+    double center[3];
+    double scale;
+} vf_object3d_transform;
+
+/* What a workspace records about its model. */
+typedef struct vf_object3d {
+    char model[VF_PATH_MAX];        /* absolute path of the model file */
+    vf_object3d_transform transform;
+    int samples;                    /* Cycles samples the training views were rendered with */
+} vf_object3d;
+
+/* Whether path names a file Blender imports here (.glb, .gltf, .obj, .blend), by its extension. */
+int vf_object3d_is_model(const char *path);
+
+typedef struct vf_object3d_capture {
+    int views;              /* training views on the upper hemisphere (default 100) */
+    int test_views;         /* held-out views, other random ones (default 25) */
+    int size;               /* square render side in pixels (default 200, as NeRF-synthetic) */
+    int samples;            /* Cycles samples a pixel (default 32; no denoiser in Debian's build) */
+    double distance;        /* camera distance (default 4) */
+    double camera_angle_x;  /* horizontal field of view, radians (default the NeRF camera) */
+    double min_elevation;   /* degrees above the horizon (default 5) */
+    uint64_t seed;          /* where on the hemisphere the views are (default 0) */
+} vf_object3d_capture;
+
+void vf_object3d_capture_defaults(vf_object3d_capture *c);
+
+/* The camera poses of the capture: views then test_views camera-to-world matrices (OpenGL
+ * axes, object frame), looking at the origin from the upper hemisphere, uniform over its area
+ * above min_elevation. c2w holds (views + test_views) * 16 doubles. */
+void vf_object3d_capture_poses(const vf_object3d_capture *c, double *c2w);
+
+/* Render the capture of the model into out_dir (a staging folder): images/r_NNN.png and
+ * test/r_NNN.png (RGBA, transparent background), transforms.json, transforms_test.json,
+ * object.json and blender.log. Views already rendered there are kept (an interrupted ingest
+ * resumes). Errors, one line each: Blender missing (VF_EINTERNAL, with the install line), a
+ * file it cannot import (VF_EINPUT, naming a missing glTF extension and how to convert),
+ * a model without geometry or whose views are all empty (VF_EINPUT). *report (may be NULL)
+ * gets the manifest summary: frames, test_frames, width, height, seconds, the transform. */
+vf_status vf_object3d_ingest(const char *model_path, const vf_object3d_capture *c,
+                             const char *out_dir, json_t **report);
+
+/* Read WS/ingest/object.json. VF_EINPUT when the workspace was not made from a 3D model (or
+ * the record is damaged), saying so. */
+vf_status vf_object3d_load(const vf_workspace *ws, vf_object3d *out);
+
+/* Render the model at n camera poses (c2w, object frame) with camera cam (pinhole; its
+ * distortion is ignored) into dir/PREFIXNNN.png, keeping files already there, and load them
+ * composited onto white into images[n] (RGB). progress_label (may be NULL) names the
+ * progress line. Blender's log goes to dir/blender.log. */
+vf_status vf_object3d_render_images(const vf_object3d *obj, const vf_camera *cam,
+                                    const double *c2w, int n, const char *dir,
+                                    const char *prefix, const char *progress_label,
+                                    vf_image *images);
+
+/* ---- the real check: the adversarial viewpoints seen on the object itself ---- */
+
+typedef struct vf_real_options {
+    const char *classifier;  /* name or path (vf_find_model); NULL: the attack's model */
+    const char *models_dir;  /* searched first for a classifier name (may be NULL) */
+    int fluctuation_samples; /* viewpoints a level r = 1..10 % (default 20, the paper's) */
+    int natural_views;       /* training views checked, spread over them (default 100) */
+    uint64_t seed;           /* the fluctuation boxes' draws (default 0) */
+} vf_real_options;
+
+void vf_real_defaults(vf_real_options *o);
+
+/* The stage `real` of a workspace made from a 3D model, after `attack`: render the model
+ * itself with the classifier camera at v*, at the attack's samples of p*(v), at fluctuation
+ * points around v* and at natural training views; classify them, and the field's renders at the
+ * same cameras; write WS/real/real.json (both columns: Real(v*), Real(p*(v)), the fluctuation
+ * curves, natural accuracy, their agreement), sheet.png (field | model, v* and samples),
+ * fluctuation.png and the model's renders. Resumable: renders already made in the staging
+ * folder are kept. *result (may be NULL) gets real.json's document (a new reference). */
+vf_status vf_real_run(vf_workspace *ws, const vf_real_options *o, json_t **result);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

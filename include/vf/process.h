@@ -1,0 +1,57 @@
+/* vf/process.h: running another program (COLMAP, Blender) as a child process.
+ *
+ * vfcapture never runs a shell: a program is found on PATH (or through an environment
+ * variable naming it), started with posix_spawn, its stdin tied to /dev/null and its stdout and
+ * stderr read line by line. Every line is appended to a log file and handed to a callback that
+ * turns the program's own words into progress and remembers its last error line.
+ *
+ * Memory: a vf_args owns its strings (vf_args_free). */
+#ifndef VF_PROCESS_H
+#define VF_PROCESS_H
+
+#include <stdio.h>
+
+#include "vf/error.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* A growing, NULL-terminated argument vector. */
+typedef struct vf_args {
+    char **items;
+    int count, capacity;
+} vf_args;
+
+/* Append one argument (copied). Out-of-memory is remembered and reported by vf_process_run. */
+void vf_args_add(vf_args *args, const char *item);
+/* Append "--name" and its formatted value,
+ * e.g. vf_args_opt(a, "--Mapper.ba_refine_focal_length", "%d", 0). */
+void vf_args_opt(vf_args *args, const char *name, const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+void vf_args_free(vf_args *args);
+
+/* The program named by the environment variable env_var when it is set (it must be
+ * executable), else the first executable `name` on PATH. VF_EINTERNAL when there is none:
+ * "NAME is not installed: INSTALL_HINT" (or naming the bad variable). */
+vf_status vf_find_program(const char *env_var, const char *name, const char *install_hint,
+                          char *out, size_t size);
+
+/* Called with each line the child prints (newline removed). */
+typedef void (*vf_process_line_fn)(const char *line, void *ctx);
+
+/* Run `program args...` (args->items[0] is argv[1]) and wait for it. Its output goes to log
+ * (may be NULL) and, line by line, to on_line (may be NULL). *exit_code gets the exit status,
+ * or -1 when it was killed by a signal (then *signal_out, when not NULL, gets the signal).
+ * Fails (VF_EINTERNAL) only when the program cannot be started; a non-zero exit is for the
+ * caller to judge. */
+vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
+                         vf_process_line_fn on_line, void *ctx, int *exit_code, int *signal_out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,201 @@
+# vfcapture's adapter for 3D models: Blender renders a textured model from given cameras.
+#
+# Run by src/object3d/blender.c as
+#     blender -b --factory-startup -t THREADS --python blender_render.py -- JOB.json
+# JOB.json says what to render:
+#     model        the .glb / .gltf / .obj / .blend file
+#     normalize    {"center": [x, y, z], "scale": s} to reuse a recorded transform, or null to
+#                  centre the model's bounding box at the origin and scale it into the unit sphere
+#     width, height, fx, fy, cx, cy   the pinhole camera (pixels)
+#     samples      Cycles samples a pixel (adaptive sampling; this build has no denoiser)
+#     views        [{"file": NAME.png, "c2w": 16 numbers}], camera-to-world, row-major,
+#                  OpenGL axes (x right, y up, looking along -z), in the normalized object frame
+#                  (z up: Blender's own world axes; the glTF importer turns y-up into z-up)
+#     output_dir   where the PNGs go (RGBA, transparent background, 8 bit, sRGB)
+#     info         where to write what was measured: the transform, vertex and mesh counts
+# It prints one "vf-view I N FILE" line a finished view and "vf-error: MESSAGE" before a
+# non-zero exit (2: the input is at fault, 4: the installation), so the C side can show
+# progress and one clear error line. Views whose PNG
+# already exists are skipped (an interrupted ingest resumes), and every PNG is written under a
+# temporary name first, so a killed render never leaves a half-written image.
+import json
+import os
+import sys
+
+
+def fail(message, code=2):
+    print("vf-error: " + message, flush=True)
+    sys.stdout.flush()
+    os._exit(code)
+
+
+try:
+    import numpy
+    # Debian 12's Blender 3.4 importer still uses np.bool, which numpy 1.24 removed.
+    if not hasattr(numpy, "bool"):
+        numpy.bool = bool
+except ImportError:
+    fail("Blender's Python has no numpy, which its glTF importer needs: "
+         "apt-get install python3-numpy", 4)
+
+import bpy
+import mathutils
+
+argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+if len(argv) != 1:
+    fail("usage: blender -b --python blender_render.py -- JOB.json")
+with open(argv[0]) as f:
+    job = json.load(f)
+
+
+def import_model(path):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    ext = os.path.splitext(path)[1].lower()
+    try:
+        if ext in (".glb", ".gltf"):
+            bpy.ops.import_scene.gltf(filepath=path)
+        elif ext == ".obj":
+            bpy.ops.wm.obj_import(filepath=path)
+        elif ext == ".blend":
+            bpy.ops.wm.open_mainfile(filepath=path)
+        else:
+            fail("cannot read %s: give a .glb, .gltf, .obj or .blend file" % path)
+    except Exception as e:  # the importer's own words name the missing extension
+        text = " ".join(str(e).split())
+        if "Extension" in text and "not available" in text:
+            start = text.find("Extension")
+            fail("%s needs a glTF extension Blender's importer lacks (%s); convert it to a "
+                 "plain .glb first, e.g. npx @gltf-transform/cli copy IN.glb OUT.glb"
+                 % (path, text[start:start + 120].split(" is ")[0]))
+        if "draco" in text.lower():
+            fail("%s is Draco-compressed and this Blender has no Draco decoder; convert it to a "
+                 "plain .glb first, e.g. npx @gltf-transform/cli copy IN.glb OUT.glb" % path)
+        fail("Blender cannot import %s: %s" % (path, text[:300]))
+
+
+def first_frame():
+    scene = bpy.context.scene
+    starts = [a.frame_range[0] for a in bpy.data.actions]
+    scene.frame_set(int(min(starts)) if starts else scene.frame_start)
+
+
+def world_vertices(meshes):
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    chunks = []
+    for obj in meshes:
+        ev = obj.evaluated_get(depsgraph)
+        mesh = ev.to_mesh()
+        n = len(mesh.vertices)
+        if n:
+            co = numpy.empty(n * 3, dtype=numpy.float64)
+            mesh.vertices.foreach_get("co", co)
+            co = co.reshape(n, 3)
+            m = numpy.array(ev.matrix_world)
+            chunks.append(co @ m[:3, :3].T + m[:3, 3])
+        ev.to_mesh_clear()
+    return numpy.concatenate(chunks) if chunks else numpy.zeros((0, 3))
+
+
+def normalize(meshes, recorded):
+    points = world_vertices(meshes)
+    if len(points) == 0:
+        fail("%s has no geometry to render (no mesh with vertices)" % job["model"])
+    if recorded:
+        center = numpy.array(recorded["center"], dtype=numpy.float64)
+        scale = float(recorded["scale"])
+    else:
+        center = (points.min(axis=0) + points.max(axis=0)) / 2
+        radius = numpy.sqrt(((points - center) ** 2).sum(axis=1)).max()
+        if not radius > 0:
+            fail("%s renders empty: all its vertices are at one point" % job["model"])
+        scale = 1.0 / radius
+    # One parent moves everything: x_object = scale * (x_blender - center).
+    root = bpy.data.objects.new("vf_normalize", None)
+    bpy.context.scene.collection.objects.link(root)
+    for obj in list(bpy.context.scene.objects):
+        if obj.parent is None and obj is not root:
+            world = obj.matrix_world.copy()
+            obj.parent = root
+            obj.matrix_world = world
+    root.matrix_world = (mathutils.Matrix.Scale(scale, 4) @
+                         mathutils.Matrix.Translation(mathutils.Vector(-center)))
+    bpy.context.view_layer.update()
+    moved = world_vertices(meshes)
+    return {"center": center.tolist(), "scale": scale, "vertices": int(len(points)),
+            "meshes": len(meshes), "bbox_min": moved.min(axis=0).tolist(),
+            "bbox_max": moved.max(axis=0).tolist(),
+            "radius": float(numpy.sqrt((moved ** 2).sum(axis=1)).max())}
+
+
+def setup_scene():
+    scene = bpy.context.scene
+    for obj in list(scene.objects):  # a controlled scene: our camera, our light
+        if obj.type in ("LIGHT", "CAMERA"):
+            bpy.data.objects.remove(obj, do_unlink=True)
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = int(job.get("samples", 64))
+    scene.cycles.use_adaptive_sampling = True
+    scene.cycles.use_denoising = False  # Debian's build has no OpenImageDenoise
+    scene.cycles.max_bounces = 8
+    scene.render.use_persistent_data = True  # textures and BVH stay loaded from view to view
+    scene.render.film_transparent = True
+    scene.view_settings.view_transform = "Standard"  # white stays white, colours as textured
+    scene.view_settings.look = "None"
+    scene.render.resolution_x = int(job["width"])
+    scene.render.resolution_y = int(job["height"])
+    scene.render.resolution_percentage = 100
+    scene.render.image_settings.file_format = "PNG"
+    scene.render.image_settings.color_mode = "RGBA"
+    scene.render.image_settings.color_depth = "8"
+    # A white studio: uniform white light from every direction, plus a soft key light above.
+    world = bpy.data.worlds.new("vf_world")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs[0].default_value = (1, 1, 1, 1)
+    world.node_tree.nodes["Background"].inputs[1].default_value = 1.0
+    scene.world = world
+    sun = bpy.data.lights.new("vf_key", "SUN")
+    sun.energy = 2.0
+    sun.angle = 0.5
+    key = bpy.data.objects.new("vf_key", sun)
+    key.rotation_euler = (0.6, 0.2, 0.8)
+    scene.collection.objects.link(key)
+
+    cam_data = bpy.data.cameras.new("vf_camera")
+    w, h = float(job["width"]), float(job["height"])
+    fx, fy = float(job["fx"]), float(job["fy"])
+    cam_data.sensor_fit = "AUTO"  # the sensor spans the larger side
+    cam_data.sensor_width = 36.0
+    cam_data.lens = (fx if w >= h else fy) * cam_data.sensor_width / max(w, h)
+    cam_data.shift_x = (w / 2 - float(job["cx"])) / max(w, h)
+    cam_data.shift_y = (float(job["cy"]) - h / 2) / max(w, h)
+    scene.render.pixel_aspect_x = 1.0
+    scene.render.pixel_aspect_y = fx / fy if w >= h else 1.0
+    cam_data.clip_start = 0.01
+    cam_data.clip_end = 100.0
+    camera = bpy.data.objects.new("vf_camera", cam_data)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    return scene, camera
+
+
+import_model(job["model"])
+first_frame()
+meshes = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+info = normalize(meshes, job.get("normalize"))
+scene, camera = setup_scene()
+with open(job["info"] + ".tmp", "w") as f:
+    json.dump(info, f, indent=1)
+os.replace(job["info"] + ".tmp", job["info"])
+
+views = job["views"]
+for i, view in enumerate(views):
+    out = os.path.join(job["output_dir"], view["file"])
+    if not os.path.exists(out):
+        c2w = view["c2w"]
+        camera.matrix_world = mathutils.Matrix([c2w[0:4], c2w[4:8], c2w[8:12], c2w[12:16]])
+        partial = out + ".partial.png"
+        scene.render.filepath = partial
+        bpy.ops.render.render(write_still=True)
+        os.replace(partial, out)
+    print("vf-view %d %d %s" % (i + 1, len(views), view["file"]), flush=True)

@@ -1,0 +1,159 @@
+/* Child processes: argument vectors, finding a program, spawning it with its output read line
+ * by line into a log and a callback. */
+#define _GNU_SOURCE
+#include "vf/process.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "vf/fsutil.h"
+
+extern char **environ;
+
+void vf_args_add(vf_args *args, const char *item)
+{
+    if (args->count + 2 > args->capacity) {
+        int capacity = args->capacity ? 2 * args->capacity : 32;
+        char **items = realloc(args->items, (size_t)capacity * sizeof *items);
+        if (!items)
+            return; /* vf_process_run sees the missing terminator and fails */
+        args->items = items;
+        args->capacity = capacity;
+    }
+    char *copy = strdup(item);
+    if (!copy)
+        return;
+    args->items[args->count++] = copy;
+    args->items[args->count] = NULL;
+}
+
+void vf_args_opt(vf_args *args, const char *name, const char *fmt, ...)
+{
+    char value[VF_PATH_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(value, sizeof value, fmt, ap);
+    va_end(ap);
+    vf_args_add(args, name);
+    vf_args_add(args, value);
+}
+
+void vf_args_free(vf_args *args)
+{
+    for (int i = 0; i < args->count; i++)
+        free(args->items[i]);
+    free(args->items);
+    memset(args, 0, sizeof *args);
+}
+
+/* The first executable named `name` on PATH. */
+static int find_on_path(const char *name, char *out, size_t size)
+{
+    const char *path = getenv("PATH");
+    if (!path || !*path)
+        path = "/usr/local/bin:/usr/bin:/bin";
+    while (*path) {
+        size_t len = strcspn(path, ":");
+        if (len > 0 && (size_t)snprintf(out, size, "%.*s/%s", (int)len, path, name) < size &&
+            access(out, X_OK) == 0)
+            return 1;
+        path += len + (path[len] == ':');
+    }
+    return 0;
+}
+
+vf_status vf_find_program(const char *env_var, const char *name, const char *install_hint,
+                          char *out, size_t size)
+{
+    const char *override = env_var ? getenv(env_var) : NULL;
+    if (override && *override) {
+        if (access(override, X_OK) != 0)
+            return vf_fail(VF_EINTERNAL, "%s=%s is not an executable program", env_var, override);
+        snprintf(out, size, "%s", override);
+        return VF_OK;
+    }
+    if (!find_on_path(name, out, size))
+        return vf_fail(VF_EINTERNAL, "%s is not installed: %s", name, install_hint);
+    return VF_OK;
+}
+
+static vf_status spawn(const char *program, const vf_args *args, int out_fd, pid_t *pid)
+{
+    char *argv[args->count + 2];
+    argv[0] = (char *)program;
+    for (int i = 0; i < args->count; i++)
+        argv[i + 1] = args->items[i];
+    argv[args->count + 1] = NULL;
+
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_adddup2(&actions, out_fd, 1);
+    posix_spawn_file_actions_adddup2(&actions, out_fd, 2);
+    posix_spawn_file_actions_addclose(&actions, out_fd);
+    int err = posix_spawn(pid, program, &actions, NULL, argv, environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (err)
+        return vf_fail(VF_EINTERNAL, "cannot run %s: %s", program, strerror(err));
+    return VF_OK;
+}
+
+/* Copy the child's output to the log and the callback, line by line. */
+static void follow_output(int fd, FILE *log, vf_process_line_fn on_line, void *ctx)
+{
+    FILE *in = fdopen(fd, "r");
+    if (!in) {
+        close(fd);
+        return;
+    }
+    char *line = NULL;
+    size_t cap = 0;
+    ssize_t len;
+    while ((len = getline(&line, &cap, in)) > 0) {
+        if (log)
+            fwrite(line, 1, (size_t)len, log);
+        if (line[len - 1] == '\n')
+            line[len - 1] = '\0';
+        if (on_line)
+            on_line(line, ctx);
+    }
+    free(line);
+    fclose(in);
+    if (log)
+        fflush(log);
+}
+
+vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
+                         vf_process_line_fn on_line, void *ctx, int *exit_code, int *signal_out)
+{
+    *exit_code = -1;
+    if (signal_out)
+        *signal_out = 0;
+    if (!args->items || args->items[args->count] != NULL)
+        return vf_fail(VF_EINTERNAL, "out of memory building the command line of %s", program);
+    int fds[2];
+    if (pipe2(fds, O_CLOEXEC) != 0)
+        return vf_fail(VF_EINTERNAL, "cannot create a pipe: %s", strerror(errno));
+    pid_t pid;
+    vf_status status = spawn(program, args, fds[1], &pid);
+    close(fds[1]);
+    if (status != VF_OK) {
+        close(fds[0]);
+        return status;
+    }
+    follow_output(fds[0], log, on_line, ctx);
+    int wstatus;
+    while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR)
+        ;
+    if (WIFEXITED(wstatus))
+        *exit_code = WEXITSTATUS(wstatus);
+    else if (WIFSIGNALED(wstatus) && signal_out)
+        *signal_out = WTERMSIG(wstatus);
+    return VF_OK;
+}
