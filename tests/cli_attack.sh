@@ -6,10 +6,7 @@ source "$(dirname "$0")/shell_checks.sh"
 
 chair="$shared/data/nerf_synthetic/chair/transforms_train.json"
 
-for cmd in attack transfer; do
-  expect 0 "$cmd --help" -- "$tool" "$cmd" --help
-  grep -q "usage: vfcapture $cmd" "$tmp/out" && ok || bad "$cmd --help prints its usage"
-done
+help_works attack transfer
 
 ws="$tmp/ws"
 expect 0 "ingest chair" -- "$tool" ingest --transforms "$chair" -o "$ws" --quiet

@@ -8,10 +8,7 @@ chair="$shared/data/nerf_synthetic/chair/transforms_train.json"
 expect 0 "tool help" -- "$tool" --help
 grep -q "ingest" "$tmp/out" && ok || bad "tool help lists commands"
 # The command list runs from "commands:" to the next blank line.
-for cmd in $("$tool" --help | awk '/^commands:/{on=1; next} on && !NF {exit} on {print $1}'); do
-  expect 0 "$cmd --help" -- "$tool" "$cmd" --help
-  grep -q "usage: vfcapture $cmd" "$tmp/out" && ok || bad "$cmd --help prints its usage"
-done
+help_works $("$tool" --help | awk '/^commands:/{on=1; next} on && !NF {exit} on {print $1}')
 expect 1 "unknown command" -- "$tool" frobnicate
 expect 1 "unknown option" -- "$tool" ingest --frobnicate
 

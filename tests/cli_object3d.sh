@@ -8,10 +8,7 @@
 source "$(dirname "$0")/shell_checks.sh"
 
 models="$shared/data/models_3d"
-for cmd in ingest real; do
-  expect 0 "$cmd --help" -- "$tool" "$cmd" --help
-  grep -q "usage: vfcapture $cmd" "$tmp/out" && ok || bad "$cmd --help prints its usage"
-done
+help_works ingest real
 grep -q "MODEL.glb" <("$tool" ingest --help) && ok || bad "ingest --help names 3D models"
 
 tiny=(--views 3 --test-views 1 --render-size 16 --samples 1 --quiet)

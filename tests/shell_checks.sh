@@ -27,6 +27,13 @@ json_check() {
   python3 -c "import json,sys; d=json.load(open(sys.argv[1])); sys.exit(0 if ($2) else 1)" "$tmp/out" \
     && ok || bad "$1: $(head -c 400 "$tmp/out")"
 }
+# help_works COMMAND...: each prints its usage with --help and exits 0
+help_works() {
+  for cmd in "$@"; do
+    expect 0 "$cmd --help" -- "$tool" "$cmd" --help
+    grep -q "usage: vfcapture $cmd" "$tmp/out" && ok || bad "$cmd --help prints its usage"
+  done
+}
 cli_finish() {
   echo "$passed passed, $failed failed"
   [ "$failed" -eq 0 ]

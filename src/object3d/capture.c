@@ -15,7 +15,6 @@
 #include "vf/rng.h"
 
 #define OBJECT_FORMAT 1
-#define REQUEST_FILE "request.json" /* what the staging folder's renders were made for */
 #define EMPTY_ALPHA 0.5             /* a pixel shows the object above this opacity */
 
 int vf_object3d_is_model(const char *path)
@@ -118,23 +117,8 @@ static vf_status prepare_folder(const char *model, const vf_object3d_capture *c,
                                 c->test_views, "size", c->size, "samples", c->samples,
                                 "distance", c->distance, "camera_angle_x", c->camera_angle_x,
                                 "min_elevation", c->min_elevation, "seed", (json_int_t)c->seed);
-    char path[VF_PATH_MAX], images[VF_PATH_MAX], test[VF_PATH_MAX];
-    vf_status status = vf_path_join(path, sizeof path, out_dir, REQUEST_FILE);
-    if (status == VF_OK)
-        status = vf_path_join(images, sizeof images, out_dir, "images");
-    if (status == VF_OK)
-        status = vf_path_join(test, sizeof test, out_dir, "test");
-    json_t *before = NULL;
-    if (status == VF_OK && vf_is_file(path) && vf_json_load(path, &before) == VF_OK &&
-        json_equal(before, request))
-        vf_info("continuing the renders of an interrupted ingest");
-    else if (status == VF_OK && (status = vf_remove_tree(images)) == VF_OK)
-        status = vf_remove_tree(test);
-    json_decref(before);
-    if (status == VF_OK)
-        status = vf_json_save(path, request);
-    json_decref(request);
-    return status;
+    static const char *const renders[] = {"images", "test", NULL};
+    return vf__keep_renders_for(out_dir, request, renders);
 }
 
 static json_t *object_json(const char *model, const json_t *fit, const vf_object3d_capture *c,

@@ -21,7 +21,6 @@
 #include "vf/view_loss.h"
 
 #define STAGE "real"
-#define REQUEST_FILE "request.json"
 #define SHEET_SAMPLES 11 /* v* and this many samples, field beside model, on the sheet */
 #define SHEET_COLUMNS 6
 
@@ -140,7 +139,6 @@ static vf_status make_cameras(real_run *r)
  * the same model, camera and cameras. */
 static vf_status prepare_renders(real_run *r, char *dir, size_t size)
 {
-    char path[VF_PATH_MAX];
     json_t *poses = json_array();
     for (int i = 0; i < 16 * r->n; i++)
         json_array_append_new(poses, json_real(r->c2w[i]));
@@ -148,20 +146,9 @@ static vf_status prepare_renders(real_run *r, char *dir, size_t size)
                                 r->obj.model, "width", r->cam.width, "height", r->cam.height,
                                 "fx", r->cam.fx, "fy", r->cam.fy, "cx", r->cam.cx, "cy",
                                 r->cam.cy, "samples", r->obj.samples, "c2w", poses);
-    json_t *before = NULL;
-    vf_status s = vf_path_join(path, sizeof path, r->stage.dir, REQUEST_FILE);
-    if (s == VF_OK)
-        s = vf_path_join(dir, size, r->stage.dir, "renders");
-    if (s == VF_OK && vf_is_file(path) && vf_json_load(path, &before) == VF_OK &&
-        json_equal(before, request))
-        vf_info("continuing the renders of an interrupted run");
-    else if (s == VF_OK)
-        s = vf_remove_tree(dir);
-    json_decref(before);
-    if (s == VF_OK)
-        s = vf_json_save(path, request);
-    json_decref(request);
-    return s;
+    static const char *const renders[] = {"renders", NULL};
+    vf_status s = vf_path_join(dir, size, r->stage.dir, "renders");
+    return s == VF_OK ? vf__keep_renders_for(r->stage.dir, request, renders) : s;
 }
 
 /* How closely the field reproduces the object at each camera. */
