@@ -102,11 +102,6 @@ static vf_status classify_chunk(vf_view_loss *vl, const vf_image *images, int n,
     return VF_OK;
 }
 
-static vf_status classify_rendered(vf_view_loss *vl, int n, vf_view_prediction *out)
-{
-    return classify_chunk(vl, vl->images, n, out);
-}
-
 vf_status vf_view_loss_classify_images(vf_view_loss *vl, const vf_image *images, int n,
                                        vf_view_prediction *out)
 {
@@ -137,7 +132,7 @@ vf_status vf_view_loss_classify(vf_view_loss *vl, const double *views, int n,
         vf_status status = vf_field_render_viewpoints(vl->field, &vl->camera, vp, m, vl->images);
         vl->stats.render_seconds += vf_now() - t0;
         if (status == VF_OK)
-            status = classify_rendered(vl, m, out + first);
+            status = classify_chunk(vl, vl->images, m, out + first);
         if (status != VF_OK)
             return status;
         for (int i = 0; losses && i < m; i++)
@@ -156,7 +151,7 @@ vf_status vf_view_loss_classify_poses(vf_view_loss *vl, const double *c2w, int n
             vf_field_render_batch(vl->field, &vl->camera, c2w + 16 * (size_t)first, m, vl->images);
         vl->stats.render_seconds += vf_now() - t0;
         if (status == VF_OK)
-            status = classify_rendered(vl, m, out + first);
+            status = classify_chunk(vl, vl->images, m, out + first);
         if (status != VF_OK)
             return status;
     }
