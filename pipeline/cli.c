@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/classifier.h"
 #include "vf/log.h"
 
 int cli_common_option(int opt, cli_flags *flags, const char *command, const char *usage)
@@ -19,6 +20,13 @@ int cli_common_option(int opt, cli_flags *flags, const char *command, const char
     case CLI_OPT_JSON:
         flags->json = 1;
         return 1;
+    case CLI_OPT_ENGINE: {
+        vf_engine engine;
+        if (vf_engine_parse(optarg, &engine) != VF_OK)
+            exit(cli_fail(command, VF_EINPUT));
+        vf_classifier_set_engine(engine);
+        return 1;
+    }
     case '?':
     case ':':
         fprintf(stderr, "vfcapture %s: see 'vfcapture %s --help'\n", command, command);

@@ -13,7 +13,7 @@
 #include "vf/error.h"
 
 /* The long options every command accepts; put CLI_COMMON_OPTIONS first in its table. */
-enum { CLI_OPT_JSON = 1000, CLI_OPT_FIRST_CUSTOM = 1100 };
+enum { CLI_OPT_JSON = 1000, CLI_OPT_ENGINE, CLI_OPT_FIRST_CUSTOM = 1100 };
 #define CLI_COMMON_OPTIONS                                                                 \
     {"help", no_argument, NULL, 'h'}, {"quiet", no_argument, NULL, 'q'},                   \
         {"json", no_argument, NULL, CLI_OPT_JSON}
@@ -22,6 +22,13 @@ enum { CLI_OPT_JSON = 1000, CLI_OPT_FIRST_CUSTOM = 1100 };
     "  -q, --quiet        no progress or info messages (warnings and errors still show)\n" \
     "      --json         print the result as one JSON document on stdout\n"              \
     "  -h, --help         show this help\n"
+
+/* Commands that classify also put CLI_ENGINE_OPTION in their table and CLI_ENGINE_HELP in
+ * their help; cli_common_option applies it to the whole process (vf_classifier_set_engine). */
+#define CLI_ENGINE_OPTION {"engine", required_argument, NULL, CLI_OPT_ENGINE}
+#define CLI_ENGINE_HELP                                                                        \
+    "      --engine E     classifier engine: auto (default: onnxruntime when installed, else\n" \
+    "                     opencv), onnxruntime or opencv; also $VF_ENGINE\n"
 
 typedef struct cli_flags {
     int json;
@@ -68,5 +75,6 @@ int cmd_score(int argc, char **argv);
 int cmd_export(int argc, char **argv);
 int cmd_reshoot(int argc, char **argv);
 int cmd_real(int argc, char **argv);
+int cmd_models(int argc, char **argv);
 
 #endif

@@ -59,7 +59,7 @@ static const char usage[] =
     "                         phi 20:160, dx -0.5:0.5, dy -1:1, dz -0.5:0.5; for a real capture\n"
     "                         (poses stage) the range its photos cover\n"
     "      --seed S           random seed (default 0): the same seed gives the same result\n"
-    "      --resume           continue an interrupted attack from its last step\n" CLI_COMMON_HELP;
+    "      --resume           continue an interrupted attack from its last step\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum {
     OPT_MODELS_DIR = CLI_OPT_FIRST_CUSTOM,
@@ -128,6 +128,7 @@ static vf_status parse_options(int argc, char **argv, attack_options *opt)
 {
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
+        CLI_ENGINE_OPTION,
         {"model", required_argument, NULL, 'm'},
         {"models-dir", required_argument, NULL, OPT_MODELS_DIR},
         {"label", required_argument, NULL, 'l'},
@@ -475,6 +476,7 @@ static json_t *result_json(const attack_run *run, const vf_attack_state *st,
     vf_view_loss_stats stats = vf_view_loss_get_stats(run->vl);
     double views = stats.views ? (double)stats.views : 1.0;
     json_object_set_new(doc, "model", json_string(run->model_path));
+    json_object_set_new(doc, "engine", json_string(vf_classifier_engine(run->cls)));
     json_object_set_new(doc, "label", label_json(run));
     json_object_set_new(doc, "method", json_string(run->opt->method));
     json_object_set_new(doc, "space", json_string(run->opt->space));
@@ -614,8 +616,8 @@ static vf_status run_attack(attack_run *run)
     if (s == VF_OK)
         s = vf_classifier_open(run->model_path, &run->cls);
     if (s == VF_OK) {
-        vf_info("model %s (input %dx%d)", run->model_path, vf_classifier_input_size(run->cls),
-                vf_classifier_input_size(run->cls));
+        vf_info("model %s (input %dx%d, %s)", run->model_path, vf_classifier_input_size(run->cls),
+                vf_classifier_input_size(run->cls), vf_classifier_engine(run->cls));
         s = vf_view_loss_create(run->field, run->cls, &run->vl);
     }
     if (s == VF_OK)

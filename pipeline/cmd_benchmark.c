@@ -1,7 +1,6 @@
 /* vfcapture benchmark: an ImageNet-V style viewpoint benchmark from attacked workspaces
  * (build), and any number of classifiers scored on it (eval). vf/vbench.h does the work. */
 #define _GNU_SOURCE
-#include <dirent.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -30,8 +29,8 @@ static const char usage[] =
     "  -n, --count N          build: images per object and split (default 100)\n"
     "      --seed S           build: sampling seed (default 0)\n"
     "      --models LIST      eval: model names or .onnx paths, comma-separated, or 'all' for\n"
-    "                         every model in the shared models folder (default " VF_DEFAULT_MODEL
-    ")\n" CLI_COMMON_HELP;
+    "                         every model found by name (see vfcapture models; default " VF_DEFAULT_MODEL
+    ")\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum { OPT_SEED = CLI_OPT_FIRST_CUSTOM, OPT_MODELS };
 
@@ -45,6 +44,7 @@ static vf_status parse_options(int argc, char **argv, benchmark_options *opt)
 {
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
+        CLI_ENGINE_OPTION,
         {"output", required_argument, NULL, 'o'},
         {"count", required_argument, NULL, 'n'},
         {"seed", required_argument, NULL, OPT_SEED},
@@ -73,34 +73,15 @@ static vf_status parse_options(int argc, char **argv, benchmark_options *opt)
     return VF_OK;
 }
 
-static int has_onnx_suffix(const char *name)
-{
-    size_t n = strlen(name);
-    return n > 5 && !strcmp(name + n - 5, ".onnx");
-}
-
-static int compare_strings(const void *a, const void *b)
-{
-    return strcmp(*(char *const *)a, *(char *const *)b);
-}
-
-/* Every .onnx file in the shared models folder, sorted. */
+/* Every model vf_model_list finds. */
 static vf_status all_models(char **paths, int *count)
 {
-    char dir[VF_PATH_MAX];
-    vf_status status = vf_shared_path("models", dir, sizeof dir);
-    DIR *d = status == VF_OK ? opendir(dir) : NULL;
-    if (status == VF_OK && !d)
-        return vf_fail(VF_EINPUT, "cannot list the models folder %s", dir);
-    struct dirent *e;
-    while (status == VF_OK && (e = readdir(d)))
-        if (has_onnx_suffix(e->d_name) && *count < MAX_MODELS &&
-            asprintf(&paths[(*count)++], "%s/%s", dir, e->d_name) < 0)
-            status = vf_fail(VF_EINTERNAL, "out of memory");
-    if (d)
-        closedir(d);
-    qsort(paths, (size_t)*count, sizeof *paths, compare_strings);
-    return status;
+    static char found[MAX_MODELS][VF_PATH_MAX];
+    int n = vf_model_list(NULL, found, MAX_MODELS);
+    for (*count = 0; *count < n && *count < MAX_MODELS; (*count)++)
+        if (!(paths[*count] = strdup(found[*count])))
+            return vf_fail(VF_EINTERNAL, "out of memory");
+    return VF_OK;
 }
 
 static vf_status resolve_models(const char *list, char **paths, int *count)
@@ -138,6 +119,11 @@ static void print_results(const vf_vbench_results *r, const char *dir)
                    rows[1].total ? 100.0 * rows[1].correct / rows[1].total : 0.0, rows[1].total);
         }
     }
+    for (int m = 0; m < r->model_count; m++) {
+        char model[256];
+        vf_path_basename(model, sizeof model, r->models[m], 1);
+        printf("%s%s: %s", m ? ", " : "\nengines: ", model, r->engines[m] ? r->engines[m] : "?");
+    }
     printf("\nreports: %s/results.md, %s/results.csv, %s/accuracy.png\n", dir, dir, dir);
 }
 
@@ -147,7 +133,8 @@ static json_t *results_json(const vf_vbench_results *r)
     for (int i = 0; i < r->row_count; i++) {
         const vf_vbench_row *row = &r->rows[i];
         json_array_append_new(
-            rows, json_pack("{s:s, s:s, s:s, s:i, s:i}", "model", r->models[row->model], "object",
+            rows, json_pack("{s:s, s:s, s:s, s:s, s:i, s:i}", "model", r->models[row->model],
+                            "engine", r->engines[row->model] ? r->engines[row->model] : "", "object",
                             row->object < 0 ? "all" : r->objects[row->object], "split",
                             row->split == VF_VBENCH_NATURAL ? "natural" : "adversarial",
                             "correct", row->correct, "total", row->total));

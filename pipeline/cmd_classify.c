@@ -24,13 +24,13 @@ static const char usage[] =
     "With --label, also say whether each top-1 is in the true label set, and the accuracy.\n"
     "\n"
     "options:\n"
-    "  -m, --model NAME|PATH  model name (in --models-dir, $VF_MODELS_DIR or the shared\n"
-    "                         models folder) or an .onnx file (default " VF_DEFAULT_MODEL ")\n"
+    "  -m, --model NAME|PATH  model name (see vfcapture models) or an .onnx file\n"
+    "                         (default " VF_DEFAULT_MODEL ")\n"
     "      --models-dir DIR   look for model names here first\n"
     "  -k, --top K            classes to show per image, 1..1000 (default 5)\n"
     "  -l, --label SET        true classes: indices and/or names, comma-separated\n"
     "                         (\"folding chair, rocking chair\" or \"559,765\"); a top-1 in\n"
-    "                         the set counts as correct\n" CLI_COMMON_HELP;
+    "                         the set counts as correct\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum { OPT_MODELS_DIR = CLI_OPT_FIRST_CUSTOM };
 #define MAX_LABELS 32
@@ -50,6 +50,7 @@ static vf_status parse_options(int argc, char **argv, classify_options *opt)
 {
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
+        CLI_ENGINE_OPTION,
         {"model", required_argument, NULL, 'm'},
         {"models-dir", required_argument, NULL, OPT_MODELS_DIR},
         {"top", required_argument, NULL, 'k'},
@@ -194,17 +195,19 @@ static vf_status run(const classify_options *opt)
     if (status != VF_OK)
         return status;
     int size = vf_classifier_input_size(cls);
-    vf_info("model %s (input %dx%d)", model_path, size, size);
+    vf_info("model %s (input %dx%d, %s)", model_path, size, size, vf_classifier_engine(cls));
     json_t *list = opt->flags.json ? json_array() : NULL;
     int correct = 0;
     status = classify_all(cls, opt, list, &correct);
+    char engine[64];
+    snprintf(engine, sizeof engine, "%s", vf_classifier_engine(cls));
     vf_classifier_close(cls);
     double accuracy = (double)correct / opt->image_count;
     if (status == VF_OK && opt->label_count && !list)
         printf("top-1 accuracy: %d of %d (%.1f%%)\n", correct, opt->image_count, 100 * accuracy);
     if (status == VF_OK && list) {
-        json_t *doc = json_pack("{s:s, s:i, s:o}", "model", model_path, "input_size", size,
-                                "images", list);
+        json_t *doc = json_pack("{s:s, s:s, s:i, s:o}", "model", model_path, "engine", engine,
+                                "input_size", size, "images", list);
         if (opt->label_count)
             json_object_set_new(doc, "accuracy", json_real(accuracy));
         cli_print_json(doc);

@@ -35,7 +35,7 @@ static const char usage[] =
     "Writes WS/export/targets.json, targets.csv, previews/ and shot_card.png.\n"
     "\n"
     "options:\n"
-    "  -n, --count M          samples of p*(v) besides v* (default 8)\n" CLI_COMMON_HELP;
+    "  -n, --count M          samples of p*(v) besides v* (default 8)\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 typedef struct target {
     vf_viewpoint v;
@@ -63,6 +63,7 @@ typedef struct export_run {
 static vf_status parse(int argc, char **argv, export_run *run, cli_flags *flags)
 {
     static const struct option longopts[] = {CLI_COMMON_OPTIONS,
+                                             CLI_ENGINE_OPTION,
                                              {"count", required_argument, NULL, 'n'},
                                              {0, 0, 0, 0}};
     run->count = DEFAULT_COUNT;

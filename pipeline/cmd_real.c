@@ -26,7 +26,7 @@ static const char usage[] =
     "      --fluctuation-samples N\n"
     "                         viewpoints a fluctuation level r = 1..10% (default 20)\n"
     "      --natural-views N  training views checked, spread over them (default 100)\n"
-    "      --seed S           draws of the fluctuation boxes (default 0)\n" CLI_COMMON_HELP;
+    "      --seed S           draws of the fluctuation boxes (default 0)\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum { OPT_MODELS_DIR = CLI_OPT_FIRST_CUSTOM, OPT_FLUCT, OPT_NATURAL, OPT_SEED };
 
@@ -48,6 +48,7 @@ static vf_status parse_options(int argc, char **argv, real_options *opt)
 {
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
+        CLI_ENGINE_OPTION,
         {"model", required_argument, NULL, 'm'},
         {"models-dir", required_argument, NULL, OPT_MODELS_DIR},
         {"fluctuation-samples", required_argument, NULL, OPT_FLUCT},

@@ -36,7 +36,7 @@ static const char usage[] =
     "      --train-steps N  train for N steps instead (the same field on a busy machine)\n"
     "      --samples K      attack samples per step (default 50)\n"
     "      --steps S        attack steps (default 100)\n"
-    "      --restart        redo every stage, even those that are up to date\n" CLI_COMMON_HELP;
+    "      --restart        redo every stage, even those that are up to date\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum { OPT_MINUTES = CLI_OPT_FIRST_CUSTOM, OPT_TRAIN_STEPS, OPT_SAMPLES, OPT_STEPS, OPT_RESTART };
 
@@ -166,6 +166,7 @@ static vf_status parse_options(int argc, char **argv, run_options *opt)
 {
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
+        CLI_ENGINE_OPTION,
         {"output", required_argument, NULL, 'o'},
         {"model", required_argument, NULL, 'm'},
         {"label", required_argument, NULL, 'l'},

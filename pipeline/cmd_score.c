@@ -39,7 +39,7 @@ static const char usage[] =
     "      --blur-ratio R     frames sharper than R x the median are used (default 0.3)\n"
     "      --summary          tabulate the scores of the given workspaces\n"
     "      --csv FILE         with --summary: also write the table as CSV\n" PHYSICAL_LOCALIZE_HELP
-        CLI_COMMON_HELP;
+        CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum { OPT_TOLERANCE = CLI_OPT_FIRST_CUSTOM, OPT_TARGET, OPT_MODEL, OPT_BLUR, OPT_SUMMARY, OPT_CSV };
 
@@ -81,7 +81,7 @@ typedef struct score_run {
 static vf_status parse(int argc, char **argv, score_options *o)
 {
     static const struct option longopts[] = {
-        CLI_COMMON_OPTIONS, PHYSICAL_LOCALIZE_OPTIONS,
+        CLI_COMMON_OPTIONS, CLI_ENGINE_OPTION, PHYSICAL_LOCALIZE_OPTIONS,
         {"tolerance", required_argument, NULL, OPT_TOLERANCE},
         {"target", required_argument, NULL, OPT_TARGET},
         {"model", required_argument, NULL, OPT_MODEL},
@@ -317,11 +317,12 @@ static json_t *tally_json(const tally *t, const char *rate_name)
 static json_t *result_json(const score_run *run)
 {
     const score_options *o = run->opt;
-    return json_pack("{s:s, s:s, s:o, s:f, s:s, s:s, s:o, s:o, s:{s:i, s:i, s:i, s:i}, s:i, "
-                     "s:f}",
+    return json_pack("{s:s, s:s, s:o, s:f, s:s, s:s, s:s, s:o, s:o, s:{s:i, s:i, s:i, s:i}, "
+                     "s:i, s:f}",
                      "workspace", o->workspace, "center", run->center_name, "center_viewpoint",
                      physical_viewpoint_json(&run->center), "tolerance_percent",
-                     100 * o->tolerance, "model", vf_classifier_path(run->cls), "label",
+                     100 * o->tolerance, "model", vf_classifier_path(run->cls), "engine",
+                     vf_classifier_engine(run->cls), "label",
                      run->attack.label_text, "kept", tally_json(&run->kept, "asr"), "natural",
                      tally_json(&run->natural, "error_rate"), "rejected", "blurry", run->blurry,
                      "not_localized", run->not_localized, "out_of_tolerance",

@@ -27,9 +27,9 @@ static const char usage[] =
     "input size work (renders keep the field of view). Writes WS/transfer/transfer.json.\n"
     "\n"
     "options:\n"
-    "      --models A,B,...   model names (in --models-dir, $VF_MODELS_DIR or the shared models\n"
-    "                         folder) or .onnx paths\n"
-    "      --models-dir DIR   look for model names here first\n" CLI_COMMON_HELP;
+    "      --models A,B,...   model names (see vfcapture models) or .onnx paths; CNNs and\n"
+    "                         transformers may be mixed\n"
+    "      --models-dir DIR   look for model names here first\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum { OPT_MODELS = CLI_OPT_FIRST_CUSTOM, OPT_MODELS_DIR };
 
@@ -51,6 +51,7 @@ static vf_status parse_options(int argc, char **argv, transfer_options *opt)
 {
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
+        CLI_ENGINE_OPTION,
         {"models", required_argument, NULL, OPT_MODELS},
         {"models-dir", required_argument, NULL, OPT_MODELS_DIR},
         {0, 0, 0, 0},
@@ -163,7 +164,8 @@ static vf_status measure_model(const char *model, const vf_field *field, const d
     if (s == VF_OK)
         s = vf_view_loss_classify(vl, r->v_star, 1, &star, NULL);
     if (s == VF_OK)
-        *row = json_pack("{s:s, s:i, s:f, s:f, s:f, s:o}", "model", model, "input_size",
+        *row = json_pack("{s:s, s:s, s:i, s:f, s:f, s:f, s:o}", "model", model, "engine",
+                         vf_classifier_engine(cls), "input_size",
                          vf_classifier_input_size(cls), "natural_accuracy", natural, "asr_samples",
                          asr, "asr_v_star", star.correct ? 0.0 : 1.0, "v_star_prediction",
                          vf_view_prediction_to_json(&star));

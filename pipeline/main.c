@@ -20,6 +20,7 @@ static const cli_command commands[] = {
     {"reshoot", cmd_reshoot, "guided capture at a target: live advice, saves frames on target"},
     {"score", cmd_score, "physical attack success rate from a re-captured video"},
     {"classify", cmd_classify, "classify images with an ImageNet model, print top-5"},
+    {"models", cmd_models, "list the classifiers found by name, with input size and engine"},
     {"benchmark", cmd_benchmark, "ImageNet-V style set from attacked objects; score classifiers"},
     {"info", cmd_info, "show a workspace's stages, parameters and outputs"},
     {"calib", cmd_calib, "camera calibration (checkerboard) and a workspace's metric scale"},

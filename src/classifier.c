@@ -1,5 +1,6 @@
-/* The plain-C half of vf/classifier.h: preprocessing, softmax, top-k, class names and label
- * sets. The network itself runs in opencv/classifier_dnn.cpp. */
+/* The plain-C half of vf/classifier.h: choosing the engine, preprocessing, softmax, top-k,
+ * class names and label sets. The network itself runs in onnxruntime/classifier_ort.c (a
+ * worker process) or opencv/classifier_dnn.cpp. */
 #define _GNU_SOURCE /* strdup, strtok_r, strncasecmp */
 #include "vf/classifier.h"
 
@@ -12,6 +13,7 @@
 #include <strings.h>
 
 #include "onnx_shape.h"
+#include "onnxruntime/classifier_ort.h"
 #include "opencv/classifier_dnn.h"
 #include "vf/fsutil.h"
 #include "vf/log.h"
@@ -24,27 +26,82 @@ static const float imagenet_mean[3] = {0.485f, 0.456f, 0.406f};
 static const float imagenet_std[3] = {0.229f, 0.224f, 0.225f};
 
 struct vf_classifier {
+    vf_ort *ort; /* exactly one of ort and dnn is set */
     vf_dnn *dnn;
     int input_size;
+    char engine[48];
     char path[VF_PATH_MAX];
 };
+
+/* ---- the engine ---- */
+
+static const char *const engine_names[] = {"auto", "onnxruntime", "opencv"};
+static int engine_chosen = -1; /* -1: not set; then $VF_ENGINE, else auto */
+
+vf_status vf_engine_parse(const char *name, vf_engine *out)
+{
+    for (int e = 0; e < 3; e++)
+        if (!strcasecmp(name, engine_names[e])) {
+            *out = (vf_engine)e;
+            return VF_OK;
+        }
+    if (!strcasecmp(name, "ort")) {
+        *out = VF_ENGINE_ONNXRUNTIME;
+        return VF_OK;
+    }
+    return vf_fail(VF_EINPUT, "unknown classifier engine '%s' (auto, onnxruntime or opencv)",
+                   name);
+}
+
+vf_status vf_engine_check(vf_engine engine)
+{
+    return engine == VF_ENGINE_ONNXRUNTIME ? vf_ort_available() : VF_OK;
+}
+
+const char *vf_engine_name(vf_engine engine)
+{
+    return (unsigned)engine < 3 ? engine_names[engine] : "?";
+}
+
+void vf_classifier_set_engine(vf_engine engine) { engine_chosen = (int)engine; }
+
+static vf_status default_engine(vf_engine *out)
+{
+    if (engine_chosen >= 0) {
+        *out = (vf_engine)engine_chosen;
+        return VF_OK;
+    }
+    const char *env = getenv("VF_ENGINE");
+    if (!env || !*env) {
+        *out = VF_ENGINE_AUTO;
+        return VF_OK;
+    }
+    vf_status status = vf_engine_parse(env, out);
+    if (status != VF_OK)
+        vf_error_prefix("VF_ENGINE");
+    return status;
+}
 
 /* ---- opening a model ---- */
 
 /* S from the graph input [N,3,S,S]; 0 when the file does not say. */
-static int input_size_from_graph(const char *path)
+/* S from the graph input [N,3,S,S] (or [N,S,S,3], then *nhwc is set); 0 when the file does
+ * not say. */
+static int input_size_from_graph(const char *path, int *nhwc)
 {
     char *data;
     size_t size;
+    *nhwc = 0;
     if (vf_read_file(path, &data, &size) != VF_OK)
         return 0;
     long long dims[4];
     int n = vf_onnx_input_dims((const unsigned char *)data, size, dims, 4);
     free(data);
-    if (n == 4 && (dims[1] == 3 || dims[1] == -1) && dims[2] == dims[3] && dims[2] > 0 &&
-        dims[2] <= 4096)
-        return (int)dims[2];
-    return 0;
+    if (n != 4)
+        return 0;
+    *nhwc = dims[3] == 3 && dims[1] != 3;
+    long long h = *nhwc ? dims[1] : dims[2], w = *nhwc ? dims[2] : dims[3];
+    return h == w && h > 0 && h <= 4096 ? (int)h : 0;
 }
 
 /* S from a "_<digits>" part of the file name (mobilenet_v1_0.25_128_quant.onnx); 0 when none. */
@@ -62,20 +119,51 @@ static int input_size_from_name(const char *path)
     return found;
 }
 
+/* Run the engine's forward pass. */
+static vf_status engine_forward(vf_classifier *cls, const float *nchw, int n, float *logits)
+{
+    return cls->ort ? vf_ort_forward(cls->ort, nchw, n, cls->input_size, logits, VF_NUM_CLASSES)
+                    : vf_dnn_forward(cls->dnn, nchw, n, cls->input_size, logits, VF_NUM_CLASSES);
+}
+
 vf_status vf_classifier_open(const char *model_path, vf_classifier **out)
+{
+    vf_engine engine = VF_ENGINE_AUTO;
+    vf_status status = default_engine(&engine);
+    return status == VF_OK ? vf_classifier_open_with(model_path, engine, out) : status;
+}
+
+vf_status vf_classifier_open_with(const char *model_path, vf_engine engine, vf_classifier **out)
 {
     if (!vf_is_file(model_path))
         return vf_fail(VF_EINPUT, "model file %s does not exist", model_path);
+    if (engine == VF_ENGINE_AUTO) /* onnxruntime when it is installed */
+        engine = vf_ort_available() == VF_OK ? VF_ENGINE_ONNXRUNTIME : VF_ENGINE_OPENCV;
+    vf_status status = VF_OK;
     vf_classifier *cls = calloc(1, sizeof *cls);
     if (!cls)
         return vf_fail(VF_EINTERNAL, "out of memory");
     snprintf(cls->path, sizeof cls->path, "%s", model_path);
-    vf_status status = vf_dnn_load(model_path, &cls->dnn);
+    if (engine == VF_ENGINE_ONNXRUNTIME) {
+        status = vf_ort_load(model_path, &cls->ort);
+        if (status == VF_OK) {
+            snprintf(cls->engine, sizeof cls->engine, "onnxruntime %s", vf_ort_version(cls->ort));
+            cls->input_size = vf_ort_input_size(cls->ort);
+        }
+    } else {
+        int nhwc;
+        cls->input_size = input_size_from_graph(model_path, &nhwc);
+        status = nhwc ? vf_fail(VF_EINPUT,
+                                "model %s takes NHWC input [N,S,S,3]; the opencv engine runs NCHW "
+                                "models only (use --engine onnxruntime)",
+                                model_path)
+                      : vf_dnn_load(model_path, &cls->dnn);
+        snprintf(cls->engine, sizeof cls->engine, "opencv %s", vf_dnn_version());
+    }
     if (status != VF_OK) {
         free(cls);
         return status;
     }
-    cls->input_size = input_size_from_graph(model_path);
     if (!cls->input_size)
         cls->input_size = input_size_from_name(model_path);
     if (!cls->input_size) {
@@ -86,8 +174,7 @@ vf_status vf_classifier_open(const char *model_path, vf_classifier **out)
     size_t plane = (size_t)cls->input_size * (size_t)cls->input_size;
     float *zeros = calloc(3 * plane, sizeof(float));
     float *logits = malloc(VF_NUM_CLASSES * sizeof(float));
-    status = zeros && logits ? vf_dnn_forward(cls->dnn, zeros, 1, cls->input_size, logits,
-                                              VF_NUM_CLASSES)
+    status = zeros && logits ? engine_forward(cls, zeros, 1, logits)
                              : vf_fail(VF_EINTERNAL, "out of memory");
     free(zeros);
     free(logits);
@@ -105,9 +192,12 @@ void vf_classifier_close(vf_classifier *cls)
 {
     if (!cls)
         return;
+    vf_ort_free(cls->ort);
     vf_dnn_free(cls->dnn);
     free(cls);
 }
+
+const char *vf_classifier_engine(const vf_classifier *cls) { return cls->engine; }
 
 int vf_classifier_input_size(const vf_classifier *cls) { return cls->input_size; }
 
@@ -173,10 +263,9 @@ vf_status vf_classifier_logits(vf_classifier *cls, const float *batch_nchw, int 
 {
     if (n <= 0)
         return vf_fail(VF_EINPUT, "nothing to classify (batch of %d)", n);
-    vf_status status =
-        vf_dnn_forward(cls->dnn, batch_nchw, n, cls->input_size, logits_out, VF_NUM_CLASSES);
+    vf_status status = engine_forward(cls, batch_nchw, n, logits_out);
     if (status != VF_OK)
-        vf_error_prefix("model %s", cls->path);
+        vf_error_prefix("model %s (%s)", cls->path, cls->engine);
     return status;
 }
 

@@ -5,10 +5,12 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -83,8 +85,13 @@ vf_status vf_find_program(const char *env_var, const char *name, const char *ins
     return VF_OK;
 }
 
-static vf_status spawn(const char *program, const vf_args *args, int out_fd, pid_t *pid)
+/* Start program with stdin /dev/null, stdout and stderr to out_fd and, when channel_fd >= 0,
+ * that descriptor as the child's fd 3. */
+static vf_status spawn(const char *program, const vf_args *args, int out_fd, int channel_fd,
+                       pid_t *pid)
 {
+    if (!args->items || args->items[args->count] != NULL)
+        return vf_fail(VF_EINTERNAL, "out of memory building the command line of %s", program);
     char *argv[args->count + 2];
     argv[0] = (char *)program;
     for (int i = 0; i < args->count; i++)
@@ -96,7 +103,8 @@ static vf_status spawn(const char *program, const vf_args *args, int out_fd, pid
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_adddup2(&actions, out_fd, 1);
     posix_spawn_file_actions_adddup2(&actions, out_fd, 2);
-    posix_spawn_file_actions_addclose(&actions, out_fd);
+    if (channel_fd >= 0)
+        posix_spawn_file_actions_adddup2(&actions, channel_fd, 3);
     int err = posix_spawn(pid, program, &actions, NULL, argv, environ);
     posix_spawn_file_actions_destroy(&actions);
     if (err)
@@ -135,13 +143,11 @@ vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
     *exit_code = -1;
     if (signal_out)
         *signal_out = 0;
-    if (!args->items || args->items[args->count] != NULL)
-        return vf_fail(VF_EINTERNAL, "out of memory building the command line of %s", program);
     int fds[2];
     if (pipe2(fds, O_CLOEXEC) != 0)
         return vf_fail(VF_EINTERNAL, "cannot create a pipe: %s", strerror(errno));
     pid_t pid;
-    vf_status status = spawn(program, args, fds[1], &pid);
+    vf_status status = spawn(program, args, fds[1], -1, &pid);
     close(fds[1]);
     if (status != VF_OK) {
         close(fds[0]);
@@ -156,4 +162,40 @@ vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
     else if (WIFSIGNALED(wstatus) && signal_out)
         *signal_out = WTERMSIG(wstatus);
     return VF_OK;
+}
+
+vf_status vf_process_start(const char *program, const vf_args *args, int output_fd, int *channel,
+                           int *pid)
+{
+    int fds[2];
+    if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, fds) != 0)
+        return vf_fail(VF_EINTERNAL, "cannot create a socket pair: %s", strerror(errno));
+    pid_t child;
+    vf_status status = spawn(program, args, output_fd, fds[1], &child);
+    close(fds[1]);
+    if (status != VF_OK) {
+        close(fds[0]);
+        return status;
+    }
+    *channel = fds[0];
+    *pid = (int)child;
+    return VF_OK;
+}
+
+int vf_process_finish(int pid, double timeout_s)
+{
+    int wstatus = 0;
+    for (int waited_ms = 0;; waited_ms += 10) {
+        pid_t done = waitpid((pid_t)pid, &wstatus, WNOHANG);
+        if (done == (pid_t)pid || (done < 0 && errno != EINTR))
+            break;
+        if (waited_ms >= 1000 * timeout_s) {
+            kill((pid_t)pid, SIGKILL);
+            while (waitpid((pid_t)pid, &wstatus, 0) < 0 && errno == EINTR)
+                ;
+            break;
+        }
+        usleep(10000);
+    }
+    return WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
 }

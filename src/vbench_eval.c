@@ -129,6 +129,7 @@ static vf_status eval_model(const vbench_set *s, int model, vf_vbench_results *r
     vf_status status = vf_classifier_open(r->models[model], &cls);
     if (status != VF_OK)
         return status;
+    r->engines[model] = strdup(vf_classifier_engine(cls));
     static const float white[3] = {1, 1, 1};
     float *probs = malloc((size_t)EVAL_CHUNK * VF_NUM_CLASSES * sizeof *probs);
     if (!probs)
@@ -176,9 +177,10 @@ vf_status vf_vbench_eval(const char *dir, const char *const *model_paths, int mo
     }
     out->model_count = model_count;
     out->models = calloc((size_t)model_count, sizeof *out->models);
+    out->engines = calloc((size_t)model_count, sizeof *out->engines);
     out->row_count = model_count * (set.object_count + 1) * 2;
     out->rows = calloc((size_t)out->row_count, sizeof *out->rows);
-    if (!out->models || !out->rows)
+    if (!out->models || !out->engines || !out->rows)
         status = vf_fail(VF_EINTERNAL, "out of memory");
     for (int m = 0; m < model_count && status == VF_OK; m++) {
         out->models[m] = strdup(model_paths[m]);
@@ -207,6 +209,9 @@ void vf_vbench_results_free(vf_vbench_results *r)
 {
     for (int i = 0; r->models && i < r->model_count; i++)
         free(r->models[i]);
+    for (int i = 0; r->engines && i < r->model_count; i++)
+        free(r->engines[i]);
+    free(r->engines);
     for (int i = 0; r->objects && i < r->object_count; i++)
         free(r->objects[i]);
     free(r->models);

@@ -76,6 +76,13 @@ static vf_status write_markdown(const vf_vbench_results *r, const char *path)
         }
         fputc('\n', f);
     }
+    fputs("\nEngines:", f);
+    for (int m = 0; m < r->model_count; m++) {
+        char model[256];
+        model_name(r, m, model, sizeof model);
+        fprintf(f, "%s %s %s", m ? "," : "", model, r->engines && r->engines[m] ? r->engines[m] : "?");
+    }
+    fputc('\n', f);
     return fclose(f) == 0 ? VF_OK : vf_fail(VF_EINPUT, "cannot write %s (disk full?)", path);
 }
 

@@ -5,6 +5,8 @@
 #include <string.h>
 #include <sys/wait.h>
 
+#include "vf/dataset.h"
+#include "vf/field.h"
 #include "vf/fsutil.h"
 
 int check_passed, check_failed;
@@ -49,4 +51,35 @@ int check_finish(void)
         vf_remove_tree(tmpdir);
     printf("%d passed, %d failed\n", check_passed, check_failed);
     return check_failed ? 1 : 0;
+}
+
+vf_field *vf_test_train_field(const vf_dataset *ds, int views, int steps, double max_points)
+{
+    vf_field_train_options opt;
+    vf_field_train_defaults(&opt);
+    opt.seconds = 0;
+    opt.steps = steps;
+    opt.max_points = max_points;
+    vf_field_trainer *t = NULL;
+    vf_status s = vf_field_trainer_create(&opt, &t);
+    int n = views > 0 && views < ds->count ? views : ds->count;
+    for (int i = 0; i < n && s == VF_OK; i++) {
+        vf_image img = {0};
+        s = vf_image_load(ds->frames[i].image_path, &img);
+        if (s == VF_OK)
+            s = vf_field_trainer_add_view(t, &ds->frames[i].camera, ds->frames[i].c2w, &img);
+        vf_image_free(&img);
+    }
+    if (s == VF_OK)
+        s = vf_field_trainer_start(t);
+    vf_field_train_status st = {0};
+    while (s == VF_OK && !st.done)
+        s = vf_field_trainer_step(t, &st);
+    CHECK(s == VF_OK, "training a field: %s", vf_error_message());
+    vf_field *f = s == VF_OK ? vf_field_trainer_take_field(t) : NULL;
+    vf_field_trainer_free(t);
+    if (f)
+        printf("field: %d steps on %d views in %.0f s, train PSNR %.1f dB\n", st.step, n,
+               st.elapsed, st.psnr);
+    return f;
 }

@@ -36,4 +36,11 @@ const char *vf_test_tmpdir(void);
 int vf_test_system(const char *fmt, ...);
 int check_finish(void);
 
+/* A radiance field trained for `steps` steps (no time limit, so a busy machine gives the same
+ * field) on the first `views` frames of ds (all when 0), at most max_points grid points. NULL
+ * (and a failed check) when training fails. */
+struct vf_dataset;
+struct vf_field *vf_test_train_field(const struct vf_dataset *ds, int views, int steps,
+                                     double max_points);
+
 #endif

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The pipeline end to end on a small budget: `run` on the chair (import, train, attack,
 # export), a second `run` that finds every stage up to date, `render` and `eval` of the
-# trained field, a benchmark set built and scored by every shared model, and bad input to those
+# trained field, a benchmark set built and scored by every shared model, transfer and benchmark
+# eval with CNNs and a (small, random-weight) transformer in one run, and bad input to those
 # commands failing with one line while the workspace stays as it was.
 source "$(dirname "$0")/shell_checks.sh"
 
@@ -34,6 +35,17 @@ models=$(ls "$shared/models"/*.onnx | wc -l)
 json_check "$models models (all of ../shared/models), natural and adversarial rows of 4 images" \
   "len(d['results']) == 4 * $models and all(r['total'] == 4 for r in d['results']) and len({r['model'] for r in d['results']}) == $models"
 [ -s "$tmp/set/accuracy.png" ] && [ -s "$tmp/set/results.md" ] && ok || bad "benchmark reports written"
+
+# CNNs and transformers side by side (tests/onnx_ops.py: a one-block ViT and a LayerNorm net,
+# graphs OpenCV 4.6 cannot load).
+python=/usr/bin/python3; [ -x "$python" ] || python=python3
+expect 0 "build the transformer graphs" -- "$python" "$VF_SOURCE_DIR/tests/onnx_ops.py" "$tmp/ops"
+mixed="mobilenet_v2_1.0_224_quant,$tmp/ops/tiny_vit.onnx,$tmp/ops/layernorm.onnx"
+expect 0 "transfer to a CNN and two transformers" -- "$tool" transfer "$ws" --models "$mixed" --json --quiet
+json_check "three rows, each with its engine and input size" '[r["input_size"] for r in d["models"]] == [224, 32, 16] and all(r["engine"].startswith("onnxruntime") for r in d["models"]) and all(0 <= r["natural_accuracy"] <= 1 for r in d["models"])'
+expect 0 "benchmark eval with a CNN and a transformer" -- "$tool" benchmark eval "$tmp/set" --models "mobilenet_v1_0.25_128_quant,$tmp/ops/tiny_vit.onnx" --json --quiet
+json_check "rows for both models, engines named" 'len({r["model"] for r in d["results"]}) == 2 and all(r["engine"].startswith("onnxruntime") for r in d["results"])'
+grep -q "tiny_vit onnxruntime" "$tmp/set/results.md" && ok || bad "results.md names the engines: $(tail -2 "$tmp/set/results.md")"
 
 # Bad input: one line, exit 1, the workspace as it was.
 cp "$ws/manifest.json" "$tmp/manifest.before"

@@ -24,34 +24,6 @@
 
 static const char chair_classes[] = "folding chair,rocking chair,barber chair,throne";
 
-static vf_field *train_chair(const vf_dataset *ds)
-{
-    vf_field_train_options opt;
-    vf_field_train_defaults(&opt);
-    opt.seconds = 0;
-    opt.steps = TRAIN_STEPS;
-    opt.max_points = 96.0 * 96.0 * 96.0; /* low resolution: recognisable, quick */
-    vf_field_trainer *t = NULL;
-    vf_status s = vf_field_trainer_create(&opt, &t);
-    for (int i = 0; i < ds->count && s == VF_OK; i++) {
-        vf_image img = {0};
-        s = vf_image_load(ds->frames[i].image_path, &img);
-        if (s == VF_OK)
-            s = vf_field_trainer_add_view(t, &ds->frames[i].camera, ds->frames[i].c2w, &img);
-        vf_image_free(&img);
-    }
-    if (s == VF_OK)
-        s = vf_field_trainer_start(t);
-    vf_field_train_status st = {0};
-    while (s == VF_OK && !st.done)
-        s = vf_field_trainer_step(t, &st);
-    CHECK(s == VF_OK, "training the chair: %s", vf_error_message());
-    vf_field *f = s == VF_OK ? vf_field_trainer_take_field(t) : NULL;
-    vf_field_trainer_free(t);
-    printf("chair field: %d steps in %.0f s, train PSNR %.1f dB\n", st.step, st.elapsed, st.psnr);
-    return f;
-}
-
 static double natural_accuracy(vf_view_loss *vl, const vf_dataset *ds)
 {
     int n = 0;
@@ -83,7 +55,7 @@ int main(void)
         CHECK(0, "chair data or model missing: %s", vf_error_message());
         return check_finish();
     }
-    vf_field *field = train_chair(&ds);
+    vf_field *field = vf_test_train_field(&ds, 0, TRAIN_STEPS, 96.0 * 96.0 * 96.0);
     vf_classifier *cls = NULL;
     vf_view_loss *vl = NULL;
     int labels[VF_MAX_LABELS], label_count = 0;

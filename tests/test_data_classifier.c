@@ -1,5 +1,6 @@
 /* Classifier module on real models and photos: accuracy on the ImageNet samples, input sizes,
  * bad model files, class names and label sets. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -203,6 +204,65 @@ static void test_names_and_topk(void)
     CHECK(p[0] == 0.5f && p[3] == 0.1f, "topk probabilities");
 }
 
+/* Every shared MobileNet names the 100 labelled photos alike with either engine, and the two
+ * engines' probabilities agree closely (both run the same float32 graph). */
+static void test_engines_agree(void)
+{
+    if (vf_engine_check(VF_ENGINE_ONNXRUNTIME) != VF_OK) {
+        CHECK(0, "%s", vf_error_message());
+        return;
+    }
+    static vf_image images[SAMPLE_COUNT];
+    static int labels[SAMPLE_COUNT];
+    int n = load_samples(images, labels);
+    static const char *const names[] = {
+        "mobilenet_v1_0.25_128_quant", "mobilenet_v1_0.5_160_quant", "mobilenet_v1_0.75_192_quant",
+        "mobilenet_v1_1.0_224_quant",  "mobilenet_v2_1.0_224_quant", "tf2_mobilenet_v2_1.0_224_ptq"};
+    const int count = 6;
+    char models[6][VF_PATH_MAX];
+    for (int m = 0; m < count; m++)
+        snprintf(models[m], VF_PATH_MAX, "%s/%s.onnx", vf_test_shared("models"), names[m]);
+    float *probs[2];
+    probs[0] = malloc((size_t)n * VF_NUM_CLASSES * sizeof(float));
+    probs[1] = malloc((size_t)n * VF_NUM_CLASSES * sizeof(float));
+    for (int m = 0; m < count; m++) {
+        const vf_engine engines[2] = {VF_ENGINE_OPENCV, VF_ENGINE_ONNXRUNTIME};
+        int ok = 1, correct[2] = {0, 0};
+        for (int e = 0; e < 2 && ok; e++) {
+            vf_classifier *cls = NULL;
+            ok = vf_classifier_open_with(models[m], engines[e], &cls) == VF_OK &&
+                 vf_classifier_classify_images(cls, images, n, probs[e]) == VF_OK;
+            CHECK(ok, "%s with %s: %s", models[m], vf_engine_name(engines[e]), vf_error_message());
+            vf_classifier_close(cls);
+        }
+        if (!ok)
+            continue;
+        int same = 0;
+        double worst = 0;
+        for (int i = 0; i < n; i++) {
+            int top[2];
+            for (int e = 0; e < 2; e++) {
+                vf_topk(probs[e] + (size_t)i * VF_NUM_CLASSES, 1, &top[e], NULL);
+                correct[e] += top[e] == labels[i];
+            }
+            same += top[0] == top[1];
+            for (int c = 0; c < VF_NUM_CLASSES; c++)
+                worst = fmax(worst, fabs(probs[0][(size_t)i * VF_NUM_CLASSES + c] -
+                                         probs[1][(size_t)i * VF_NUM_CLASSES + c]));
+        }
+        char name[128];
+        vf_path_basename(name, sizeof name, models[m], 1);
+        printf("%-30s top-1 opencv %d, onnxruntime %d of %d; same top-1 on %d; max |dp| %.1e\n",
+               name, correct[0], correct[1], n, same, worst);
+        CHECK(same == n, "%s: the engines disagree on %d photos", name, n - same);
+        CHECK(worst < 1e-4, "%s: probabilities differ by %g", name, worst);
+    }
+    free(probs[0]);
+    free(probs[1]);
+    for (int i = 0; i < n; i++)
+        vf_image_free(&images[i]);
+}
+
 int main(void)
 {
     vf_log_set_quiet(1);
@@ -212,5 +272,6 @@ int main(void)
     test_small_model();
     test_size_from_graph();
     test_accuracy();
+    test_engines_agree();
     return check_finish();
 }

@@ -1,8 +1,16 @@
 /* vf/classifier.h: ImageNet-1k classifiers and their class names.
  *
- * A vf_classifier is an ONNX model with input [N,3,S,S] (RGB, ImageNet mean/std, NCHW float)
- * and output [N,1000] logits, run on the CPU with OpenCV's dnn module on every core. The
- * usual use is
+ * A vf_classifier is an ONNX model with one image input (RGB, ImageNet mean/std, float; NCHW
+ * [N,3,S,S] or NHWC [N,S,S,3]) and output [N,1000] logits, run on the CPU on every core by one
+ * of two engines:
+ *
+ *   onnxruntime  ONNX Runtime (the npm package onnxruntime-node, installed by scripts/setup.sh),
+ *                run in a worker process of ours that the library talks to over a socket. It
+ *                runs what torch.onnx.export writes: CNNs and transformers (ViT, Swin, ...).
+ *   opencv       OpenCV 4.6's dnn module, in process; needs nothing more, but refuses many
+ *                exports (Identity on weights, broadcast Mul, Mod, LayerNorm as Div ...).
+ *
+ * The default, "auto", is onnxruntime when it is installed, else opencv. The usual use is
  *
  *     vf_classifier *cls;
  *     vf_classifier_open(path, &cls);                     // path from vf_find_model()
@@ -11,7 +19,9 @@
  *     vf_classifier_close(cls);
  *
  * Threads: one vf_classifier may be used by one thread at a time (OpenCV's Net is not
- * re-entrant); it parallelises internally. Open one per thread to run several at once.
+ * re-entrant, and an onnxruntime worker answers one batch at a time); it parallelises
+ * internally. Open one per thread to run several at once (each onnxruntime one is a process:
+ * about 0.3 s to start for a MobileNet, 2 s for a ViT-B/16).
  * Everything else here (preprocess, top-k, class names once loaded) is thread-safe.
  *
  * Memory: the caller owns every buffer it passes in; a vf_classifier is freed with
@@ -31,10 +41,39 @@ extern "C" {
 
 typedef struct vf_classifier vf_classifier;
 
-/* Load the ONNX model at model_path, find its input size S (from the graph, else from a
- * "_128"-style number in the file name) and check with a zero input that it gives 1000
- * outputs. VF_EINPUT "model PATH is not an ONNX classifier: ..." when it cannot be used. */
+typedef enum vf_engine {
+    VF_ENGINE_AUTO,        /* onnxruntime when installed, else opencv */
+    VF_ENGINE_ONNXRUNTIME,
+    VF_ENGINE_OPENCV,
+} vf_engine;
+
+/* "auto", "onnxruntime" (or "ort"), "opencv"; VF_EINPUT naming the choices otherwise. */
+vf_status vf_engine_parse(const char *name, vf_engine *out);
+
+/* VF_OK when the engine can be used here; else VF_EINTERNAL saying what is missing and how to
+ * install it (onnxruntime needs node and the npm package; opencv and auto always work). */
+vf_status vf_engine_check(vf_engine engine);
+
+/* The engine's name ("auto", "onnxruntime", "opencv"). */
+const char *vf_engine_name(vf_engine engine);
+
+/* The engine vf_classifier_open uses in this process (a command's --engine). Until set it is
+ * $VF_ENGINE when that names one, else auto. */
+void vf_classifier_set_engine(vf_engine engine);
+
+/* Load the ONNX model at model_path with the process's engine, find its input size S (from
+ * the graph, else from a "_128"-style number in the file name) and check with a zero input
+ * that it gives 1000 outputs. VF_EINPUT "model PATH is not an ONNX classifier: ..." when it
+ * cannot be used (with the engine's reason, which names the op it could not run). */
 vf_status vf_classifier_open(const char *model_path, vf_classifier **out);
+
+/* As vf_classifier_open with a given engine. VF_EINTERNAL when onnxruntime is asked for and is
+ * not installed. */
+vf_status vf_classifier_open_with(const char *model_path, vf_engine engine, vf_classifier **out);
+
+/* The engine that runs it, with its version: "onnxruntime 1.30.0" or "opencv 4.6.0". Every
+ * report that names a model names this too. */
+const char *vf_classifier_engine(const vf_classifier *cls);
 
 /* Free the model; NULL is fine. */
 void vf_classifier_close(vf_classifier *cls);

@@ -5,6 +5,10 @@
  * stderr read line by line. Every line is appended to a log file and handed to a callback that
  * turns the program's own words into progress and remembers its last error line.
  *
+ * A long-lived helper (the ONNX Runtime worker) is started instead with vf_process_start: it
+ * gets one end of a Unix socket as its file descriptor 3 to exchange messages on, and its
+ * stdout and stderr go to a file descriptor of the caller's (read back when it fails).
+ *
  * Memory: a vf_args owns its strings (vf_args_free). */
 #ifndef VF_PROCESS_H
 #define VF_PROCESS_H
@@ -50,6 +54,18 @@ typedef void (*vf_process_line_fn)(const char *line, void *ctx);
  * caller to judge. */
 vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
                          vf_process_line_fn on_line, void *ctx, int *exit_code, int *signal_out);
+
+/* Start `program args...` without waiting: *channel gets the caller's end of a socket whose
+ * other end is the child's fd 3, the child's stdin is /dev/null and its stdout and stderr go to
+ * output_fd. Both of the caller's descriptors are close-on-exec, so later children do not keep
+ * the socket open. Writes on *channel should use send(..., MSG_NOSIGNAL) so that a worker which
+ * died is an error, not a SIGPIPE. */
+vf_status vf_process_start(const char *program, const vf_args *args, int output_fd, int *channel,
+                           int *pid);
+
+/* Wait up to timeout_s seconds for a started child to exit, then kill it (SIGKILL) and reap it.
+ * Returns its exit status, or -1 when it was killed by a signal. */
+int vf_process_finish(int pid, double timeout_s);
 
 #ifdef __cplusplus
 }

@@ -48,6 +48,7 @@ typedef struct vf_vbench_row {
 typedef struct vf_vbench_results {
     int model_count, object_count, row_count;
     char **models;  /* model file paths */
+    char **engines; /* the engine that ran each (vf_classifier_engine) */
     char **objects; /* object names */
     vf_vbench_row *rows;
 } vf_vbench_results;

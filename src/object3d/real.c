@@ -243,9 +243,10 @@ static json_t *result_json(const real_run *r)
         }
     int ns = r->af.sample_count, nn = r->first[G_COUNT] - r->first[G_NATURAL];
     return json_pack(
-        "{s:s, s:s, s:{s:[f,f,f], s:f}, s:s, s:o, s:o, s:o, s:i, s:o, s:{s:o, s:o, s:o, s:i}, "
+        "{s:s, s:s, s:s, s:{s:[f,f,f], s:f}, s:s, s:o, s:o, s:o, s:i, s:o, s:{s:o, s:o, s:o, s:i}, "
         "s:i, s:f, s:f, s:{s:f, s:f, s:f, s:f}, s:{s:f, s:f}, s:o}",
-        "object", r->obj.model, "classifier", r->classifier_path, "transform", "center",
+        "object", r->obj.model, "classifier", r->classifier_path, "engine",
+        vf_classifier_engine(r->cls), "transform", "center",
         r->obj.transform.center[0], r->obj.transform.center[1], r->obj.transform.center[2],
         "scale", r->obj.transform.scale, "label", r->af.label_text, "asr_v_star",
         pair_json(fooled_rate(r->field_pred, 0, 1), fooled_rate(r->real_pred, 0, 1)),

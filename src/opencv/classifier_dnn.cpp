@@ -15,11 +15,36 @@ struct vf_dnn {
     cv::dnn::Net net;
 };
 
-extern "C" vf_status vf_dnn_load(const char *path, vf_dnn **out)
+// OpenCV's importer writes multi-line messages with "> " continuation marks; we print one line.
+static std::string one_line(const std::string &text)
 {
-    // OpenCV logs its own copy of a parse failure on stderr; we report it once ourselves.
+    std::string out;
+    bool space = false;
+    for (size_t i = 0; i < text.size(); i++) {
+        char c = text[i];
+        bool mark = c == '>' && (i == 0 || text[i - 1] == '\n');
+        if (c == '\n' || c == '\r' || c == '\t' || c == ' ' || mark) {
+            space = !out.empty();
+            continue;
+        }
+        if (space)
+            out += ' ';
+        out += c;
+        space = false;
+    }
+    return out;
+}
+
+// OpenCV logs its own copy of every failure on stderr; we report it once ourselves.
+struct quiet_logs {
     cv::utils::logging::LogLevel level =
         cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+    ~quiet_logs() { cv::utils::logging::setLogLevel(level); }
+};
+
+extern "C" vf_status vf_dnn_load(const char *path, vf_dnn **out)
+{
+    quiet_logs quiet;
     vf_status status = VF_OK;
     try {
         std::unique_ptr<vf_dnn> dnn(new vf_dnn);
@@ -34,7 +59,7 @@ extern "C" vf_status vf_dnn_load(const char *path, vf_dnn **out)
         *out = dnn.release();
     } catch (const cv::Exception &e) {
         // "Failed to parse ONNX model: PATH": we name the path ourselves.
-        std::string why = e.err, suffix = std::string(": ") + path;
+        std::string why = one_line(e.err), suffix = std::string(": ") + path;
         size_t keep = why.size() - suffix.size();
         if (why.size() > suffix.size() && why.compare(keep, suffix.size(), suffix) == 0)
             why.resize(keep);
@@ -42,13 +67,13 @@ extern "C" vf_status vf_dnn_load(const char *path, vf_dnn **out)
     } catch (const std::bad_alloc &) {
         status = vf_fail(VF_EINTERNAL, "out of memory loading model %s", path);
     }
-    cv::utils::logging::setLogLevel(level);
     return status;
 }
 
 extern "C" vf_status vf_dnn_forward(vf_dnn *dnn, const float *nchw, int n, int size, float *out,
                                     int classes)
 {
+    quiet_logs quiet;
     try {
         int shape[4] = {n, 3, size, size};
         // Wraps the caller's buffer without copying; dnn only reads its input.
@@ -64,7 +89,7 @@ extern "C" vf_status vf_dnn_forward(vf_dnn *dnn, const float *nchw, int n, int s
         return VF_OK;
     } catch (const cv::Exception &e) {
         return vf_fail(VF_EINPUT, "running the model on %d input(s) of %dx%d failed: %s", n, size,
-                       size, e.err.c_str());
+                       size, one_line(e.err).c_str());
     } catch (const std::bad_alloc &) {
         return vf_fail(VF_EINTERNAL, "out of memory running the model");
     }
@@ -73,4 +98,9 @@ extern "C" vf_status vf_dnn_forward(vf_dnn *dnn, const float *nchw, int n, int s
 extern "C" void vf_dnn_free(vf_dnn *dnn)
 {
     delete dnn;
+}
+
+extern "C" const char *vf_dnn_version(void)
+{
+    return CV_VERSION;
 }

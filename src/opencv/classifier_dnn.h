@@ -20,6 +20,9 @@ vf_status vf_dnn_forward(vf_dnn *net, const float *nchw, int n, int size, float 
 
 void vf_dnn_free(vf_dnn *net);
 
+/* OpenCV's version ("4.6.0"). */
+const char *vf_dnn_version(void);
+
 #ifdef __cplusplus
 }
 #endif
