@@ -68,6 +68,36 @@ vf_status vf_image_load_rgb(const char *path, const float background[3], vf_imag
     return status;
 }
 
+vf_status vf_image_reorient(const vf_image *src, int orientation, vf_image *out)
+{
+    if (orientation < 1 || orientation > 8)
+        orientation = 1;
+    int w = src->width, h = src->height, swap = orientation >= 5;
+    vf_image img;
+    vf_status status = vf_image_alloc(&img, swap ? h : w, swap ? w : h, src->channels);
+    if (status != VF_OK)
+        return status;
+    size_t c = (size_t)src->channels;
+    for (int v = 0; v < img.height; v++)
+        for (int u = 0; u < img.width; u++) {
+            int x, y; /* the stored pixel shown at (u, v) */
+            switch (orientation) {
+            case 2: x = w - 1 - u, y = v; break;
+            case 3: x = w - 1 - u, y = h - 1 - v; break;
+            case 4: x = u, y = h - 1 - v; break;
+            case 5: x = v, y = u; break;
+            case 6: x = v, y = h - 1 - u; break;
+            case 7: x = w - 1 - v, y = h - 1 - u; break;
+            case 8: x = w - 1 - v, y = u; break;
+            default: x = u, y = v; break;
+            }
+            memcpy(img.data + ((size_t)v * img.width + u) * c,
+                   src->data + ((size_t)y * w + x) * c, c * sizeof(float));
+        }
+    *out = img;
+    return VF_OK;
+}
+
 vf_status vf_image_center_crop(const vf_image *src, int width, int height, vf_image *out)
 {
     if (width <= 0 || height <= 0 || width > src->width || height > src->height)

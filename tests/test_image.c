@@ -1,9 +1,11 @@
-/* Image module: file round trips, alpha, resizing, cropping and error messages. */
+/* Image module: file round trips, alpha, resizing, cropping, EXIF orientation (the same with
+ * OpenImageIO and OpenCV) and error messages. */
 #include <string.h>
 
 #include "check.h"
 #include "vf/fsutil.h"
 #include "vf/image.h"
+#include "vf/rgb8.h"
 
 static float *pixel(const vf_image *img, int x, int y)
 {
@@ -249,6 +251,86 @@ static void test_real_frame(void)
     vf_image_free(&img);
 }
 
+/* The inverse of each EXIF orientation, and what 6 and 5 mean on a 3 x 2 image. */
+static void test_reorient(void)
+{
+    static const int inverse[9] = {0, 1, 2, 3, 4, 5, 8, 7, 6};
+    vf_image img, turned, back;
+    vf_image_alloc(&img, 3, 2, 1);
+    for (int i = 0; i < 6; i++)
+        img.data[i] = (float)i; /* rows 0 1 2 / 3 4 5 */
+    for (int o = 1; o <= 8; o++) {
+        CHECK(vf_image_reorient(&img, o, &turned) == VF_OK, "reorient %d", o);
+        CHECK(turned.width == (o >= 5 ? 2 : 3), "orientation %d: width %d", o, turned.width);
+        CHECK(vf_image_reorient(&turned, inverse[o], &back) == VF_OK, "back from %d", o);
+        CHECK(max_difference(&img, &back) == 0, "orientation %d then %d is not the identity", o,
+              inverse[o]);
+        if (o == 6) /* 90 clockwise: rows 3 0 / 4 1 / 5 2 */
+            CHECK(turned.data[0] == 3 && turned.data[1] == 0 && turned.data[5] == 2,
+                  "orientation 6: %g %g ... %g", turned.data[0], turned.data[1], turned.data[5]);
+        if (o == 5) /* transpose: rows 0 3 / 1 4 / 2 5 */
+            CHECK(turned.data[1] == 3 && turned.data[2] == 1, "orientation 5");
+        vf_image_free(&turned);
+        vf_image_free(&back);
+    }
+    vf_image_free(&img);
+}
+
+/* A phone JPEG stored sideways with EXIF orientation 6 (or 8, 3) reads upright, the same size
+ * and pixels through OpenImageIO (classify, train) and OpenCV (ingest, localize, score). */
+static void test_exif_orientation(void)
+{
+    /* Quadrants: red top left, green top right, blue bottom left, white bottom right. */
+    vf_image img;
+    vf_image_alloc(&img, 40, 24, 3);
+    for (int y = 0; y < 24; y++)
+        for (int x = 0; x < 40; x++) {
+            float *p = pixel(&img, x, y);
+            int right = x >= 20, bottom = y >= 12;
+            p[0] = (!right && !bottom) || (right && bottom);
+            p[1] = right;
+            p[2] = bottom;
+        }
+    char stored[VF_PATH_MAX];
+    snprintf(stored, sizeof stored, "%s", scratch("stored.png"));
+    CHECK(vf_image_save(stored, &img) == VF_OK, "save: %s", vf_error_message());
+    const int orientations[3] = {6, 8, 3};
+    /* The quadrant colour (r, g, b as 0/1) expected at the top left of the upright image. */
+    const int top_left[3][3] = {{0, 0, 1}, {0, 1, 0}, {1, 1, 1}};
+    for (int k = 0; k < 3; k++) {
+        char jpg[VF_PATH_MAX];
+        snprintf(jpg, sizeof jpg, "%s/o%d.jpg", vf_test_tmpdir(), orientations[k]);
+        int rc = vf_test_system("oiiotool %s --attrib Orientation %d -o %s", stored,
+                                orientations[k], jpg);
+        CHECK(rc == 0, "oiiotool failed (%d)", rc);
+        vf_image up = {0};
+        vf_rgb8 cv = {0};
+        int w = 0, h = 0, ch = 0;
+        CHECK(vf_image_info(jpg, &w, &h, &ch) == VF_OK && vf_image_load(jpg, &up) == VF_OK &&
+                  vf_rgb8_load(jpg, &cv) == VF_OK,
+              "orientation %d: %s", orientations[k], vf_error_message());
+        int want_w = orientations[k] == 3 ? 40 : 24, want_h = orientations[k] == 3 ? 24 : 40;
+        CHECK(w == want_w && h == want_h && up.width == want_w && up.height == want_h &&
+                  cv.width == want_w && cv.height == want_h,
+              "orientation %d: header %dx%d, OpenImageIO %dx%d, OpenCV %dx%d", orientations[k],
+              w, h, up.width, up.height, cv.width, cv.height);
+        if (up.width == cv.width && up.height == cv.height && up.data && cv.data) {
+            double worst = 0;
+            for (int i = 0; i < up.width * up.height * 3; i++)
+                worst = fmax(worst, fabs(up.data[i] - cv.data[i] / 255.0));
+            CHECK(worst < 0.02, "orientation %d: the decoders differ by %.3f", orientations[k],
+                  worst);
+            const float *p = pixel(&up, 2, 2);
+            CHECK(fabs(p[0] - top_left[k][0]) < 0.1 && fabs(p[1] - top_left[k][1]) < 0.1 &&
+                      fabs(p[2] - top_left[k][2]) < 0.1,
+                  "orientation %d: top left is %.2f %.2f %.2f", orientations[k], p[0], p[1], p[2]);
+        }
+        vf_image_free(&up);
+        vf_rgb8_free(&cv);
+    }
+    vf_image_free(&img);
+}
+
 int main(void)
 {
     test_png_round_trip();
@@ -259,6 +341,8 @@ int main(void)
     test_resize_constant();
     test_resize_gradient();
     test_center_crop();
+    test_reorient();
+    test_exif_orientation();
     test_errors();
     test_real_frame();
     return check_finish();

@@ -4,7 +4,9 @@
  * data[(y * width + x) * channels + c]. Values are floats, 0..1 for 8/16-bit files, exactly as
  * stored in the file: no colour management, no gamma, and alpha is straight (unassociated), as
  * in PNG. Files are read and written through OpenImageIO (PNG, JPEG, OpenEXR and whatever else
- * it reads); resizing and cropping are plain C.
+ * it reads); resizing and cropping are plain C. A JPEG's EXIF orientation is applied on reading
+ * (pixels and size as a photo viewer shows them), as vf/rgb8.h's OpenCV decoder does, so every
+ * stage sees a phone photo the same way up.
  *
  * Memory: every function that fills a vf_image allocates its pixels; the caller owns them and
  * releases them with vf_image_free(). Outputs are written only on success. Functions taking a
@@ -40,8 +42,14 @@ vf_status vf_image_load_rgb(const char *path, const float background[3], vf_imag
 /* Convert an image in memory to RGB the way vf_image_load_rgb does. */
 vf_status vf_image_to_rgb(const vf_image *src, const float background[3], vf_image *out);
 
-/* Size and channel count from the file header, without decoding the pixels. */
+/* Size (after the EXIF orientation) and channel count from the file header, without decoding
+ * the pixels. */
 vf_status vf_image_info(const char *path, int *width, int *height, int *channels);
+
+/* src as EXIF orientation `orientation` (1..8) says to show it: 1 as stored, 2 mirrored, 3
+ * turned 180 degrees, 4 flipped, 5 transposed, 6 turned 90 degrees clockwise, 7 transversed,
+ * 8 turned 90 degrees counter-clockwise (5..8 swap width and height). Other values: a copy. */
+vf_status vf_image_reorient(const vf_image *src, int orientation, vf_image *out);
 
 /* Write img to path, the format chosen by the extension: .png (8-bit), .jpg/.jpeg (8-bit,
  * alpha dropped), .exr (32-bit float). Values are clamped to 0..1 for 8-bit formats. The file

@@ -137,6 +137,15 @@ vf_status encode(const char *path, const char *format, TypeDesc type, const vf_i
     return VF_OK;
 }
 
+// The EXIF orientation (1..8) to apply: a JPEG's, as OpenCV's imread applies it; 1 otherwise.
+int orientation_of(ImageInput &in)
+{
+    if (std::strcmp(in.format_name(), "jpeg") != 0)
+        return 1;
+    int o = in.spec().get_int_attribute("Orientation", 1);
+    return o >= 1 && o <= 8 ? o : 1;
+}
+
 } // namespace
 
 extern "C" vf_status vf_image_info(const char *path, int *width, int *height, int *channels)
@@ -145,8 +154,9 @@ extern "C" vf_status vf_image_info(const char *path, int *width, int *height, in
     vf_status status = open_input(path, in);
     if (status != VF_OK)
         return status;
-    *width = in->spec().width;
-    *height = in->spec().height;
+    bool swap = orientation_of(*in) >= 5;
+    *width = swap ? in->spec().height : in->spec().width;
+    *height = swap ? in->spec().width : in->spec().height;
     *channels = in->spec().nchannels;
     return VF_OK;
 }
@@ -166,6 +176,15 @@ extern "C" vf_status vf_image_load(const char *path, vf_image *out)
     if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, img.data) || in->has_error()) {
         vf_image_free(&img);
         return vf_fail(VF_EINPUT, "cannot read %s: %s", path, first_line(in->geterror()).c_str());
+    }
+    int orientation = orientation_of(*in);
+    if (orientation != 1) {
+        vf_image shown;
+        status = vf_image_reorient(&img, orientation, &shown);
+        vf_image_free(&img);
+        if (status != VF_OK)
+            return status;
+        img = shown;
     }
     *out = img;
     return VF_OK;
