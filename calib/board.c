@@ -11,7 +11,7 @@ int vf_calib_board_corners(const vf_calib_board *board)
     return board->cols * board->rows;
 }
 
-double *calib_board_points(const vf_calib_board *board)
+double *vf__calib_board_points(const vf_calib_board *board)
 {
     int n = vf_calib_board_corners(board);
     double *xy = malloc((size_t)n * 2 * sizeof *xy);

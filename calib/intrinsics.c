@@ -16,8 +16,8 @@ void vf_calib_defaults(vf_calib_options *opt)
                               .outlier_floor = 0.5, .huber_px = 1.0};
 }
 
-double calib_view_rms(const vf_camera *cam, const double pose[6], const double *object_xy,
-                      const double *uv, int corners)
+double vf__calib_view_rms(const vf_camera *cam, const double pose[6], const double *object_xy,
+                          const double *uv, int corners)
 {
     double rot[9], sum = 0;
     int seen = 0;
@@ -60,7 +60,8 @@ static double update_errors(solve_state *s)
     double sum = 0;
     for (int k = 0; k < s->count; k++) {
         vf_calib_view *view = &s->set->views[s->used[k]];
-        view->rms = calib_view_rms(&s->cam, s->poses + 6 * k, s->object_xy, view->uv, s->corners);
+        view->rms =
+            vf__calib_view_rms(&s->cam, s->poses + 6 * k, s->object_xy, view->uv, s->corners);
         sum += view->rms * view->rms;
     }
     return sqrt(sum / s->count);
@@ -102,7 +103,7 @@ static int drop_outliers(solve_state *s, const vf_calib_options *opt)
 
 static vf_status solve(solve_state *s, const vf_calib_options *opt, vf_calib_result *out)
 {
-    s->count = calib_select_views(s->set, opt->max_views, s->used);
+    s->count = vf__calib_select_views(s->set, opt->max_views, s->used);
     for (int k = 0; k < s->count; k++)
         s->uv[k] = s->set->views[s->used[k]].uv;
     double start = vf_now();
@@ -152,7 +153,7 @@ vf_status vf_calib_solve(vf_calib_views *set, const vf_calib_board *board,
         set->views[i].state = VF_VIEW_SPARE, set->views[i].rms = 0;
     int max = opt->max_views < set->count ? opt->max_views : set->count;
     solve_state s = {.set = set, .corners = vf_calib_board_corners(board)};
-    s.object_xy = calib_board_points(board);
+    s.object_xy = vf__calib_board_points(board);
     s.used = malloc((size_t)max * sizeof *s.used);
     s.uv = malloc((size_t)max * sizeof *s.uv);
     s.poses = malloc((size_t)max * 6 * sizeof *s.poses);

@@ -2,7 +2,7 @@
 #include "calib_internal.h"
 #include "vf/pose.h"
 
-vf_status calib_load_posed_frames(const vf_workspace *ws, vf_dataset *out)
+vf_status vf__calib_load_posed_frames(const vf_workspace *ws, vf_dataset *out)
 {
     char path[VF_PATH_MAX];
     const char *stage = vf_workspace_has_stage(ws, "poses") ? "poses" : "ingest";
@@ -16,7 +16,8 @@ vf_status calib_load_posed_frames(const vf_workspace *ws, vf_dataset *out)
     return vf_dataset_load(path, out);
 }
 
-void calib_frame_ray(const vf_frame *frame, double u, double v, double origin[3], double dir[3])
+void vf__calib_frame_ray(const vf_frame *frame, double u, double v, double origin[3],
+                         double dir[3])
 {
     double c2w_cv[16], rot[9], ray[3];
     vf_c2w_gl_to_cv(frame->c2w, c2w_cv);

@@ -52,8 +52,8 @@ static vf_status triangulate(const vf_dataset *ds, const sightings *s, double X[
     double *dir = malloc((size_t)s->count * 3 * sizeof *dir);
     vf_status status = origin && dir ? VF_OK : vf_fail(VF_EINTERNAL, "out of memory");
     for (int i = 0; status == VF_OK && i < s->count; i++)
-        calib_frame_ray(&ds->frames[s->frame[i]], s->uv[2 * i], s->uv[2 * i + 1], origin + 3 * i,
-                        dir + 3 * i);
+        vf__calib_frame_ray(&ds->frames[s->frame[i]], s->uv[2 * i], s->uv[2 * i + 1],
+                            origin + 3 * i, dir + 3 * i);
     if (status == VF_OK)
         status = vf_triangulate_rays(origin, dir, s->count, X);
     free(origin);
@@ -117,7 +117,7 @@ vf_status vf_scale_from_marker(const vf_workspace *ws, int id, double size_m,
     if (id < 0 || id >= VF_ARUCO_IDS)
         return vf_fail(VF_EINPUT, "--marker: ArUco ids run from 0 to %d", VF_ARUCO_IDS - 1);
     vf_dataset ds;
-    vf_status status = calib_load_posed_frames(ws, &ds);
+    vf_status status = vf__calib_load_posed_frames(ws, &ds);
     if (status != VF_OK)
         return status;
     sightings corners[4] = {{0}};
@@ -211,7 +211,7 @@ vf_status vf_scale_from_picks(const vf_workspace *ws, const vf_pick *p1, int n1,
                               double *metres_per_unit, json_t **details)
 {
     vf_dataset ds;
-    vf_status status = calib_load_posed_frames(ws, &ds);
+    vf_status status = vf__calib_load_posed_frames(ws, &ds);
     if (status != VF_OK)
         return status;
     sightings s[2] = {{0}};

@@ -35,7 +35,7 @@ static void view_features(const vf_calib_views *set, const double quad[8], doubl
     f[4] = 2.0 * (bottom - top) / (bottom + top + 1e-9);
 }
 
-int calib_select_views(const vf_calib_views *set, int max, int *chosen)
+int vf__calib_select_views(const vf_calib_views *set, int max, int *chosen)
 {
     int n = set->count;
     if (n <= max) {

@@ -84,7 +84,6 @@ static vf_status default_engine(vf_engine *out)
 
 /* ---- opening a model ---- */
 
-/* S from the graph input [N,3,S,S]; 0 when the file does not say. */
 /* S from the graph input [N,3,S,S] (or [N,S,S,3], then *nhwc is set); 0 when the file does
  * not say. */
 static int input_size_from_graph(const char *path, int *nhwc)

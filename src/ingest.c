@@ -23,7 +23,7 @@ void vf_ingest_defaults(vf_ingest_options *options)
     options->height = 720;
 }
 
-vf_status ingest_check_options(const vf_ingest_options *options)
+vf_status vf__ingest_check_options(const vf_ingest_options *options)
 {
     if (options->max_size < 16)
         return vf_fail(VF_EINPUT, "the maximum frame size must be at least 16 pixels, not %d",
@@ -31,7 +31,7 @@ vf_status ingest_check_options(const vf_ingest_options *options)
     return VF_OK;
 }
 
-vf_status score_list_push(score_list *list, const vf_frame_score *score)
+vf_status vf__score_list_push(score_list *list, const vf_frame_score *score)
 {
     if (list->count == list->capacity) {
         int capacity = list->capacity ? 2 * list->capacity : 256;
@@ -45,7 +45,7 @@ vf_status score_list_push(score_list *list, const vf_frame_score *score)
     return VF_OK;
 }
 
-void score_list_free(score_list *list)
+void vf__score_list_free(score_list *list)
 {
     free(list->items);
     memset(list, 0, sizeof *list);
@@ -64,7 +64,7 @@ void vf_ingest_source_kind(const char *ws_root, char *kind, size_t size)
     json_decref(doc);
 }
 
-json_t *ingest_report_new(const char *kind, const char *path)
+json_t *vf__ingest_report_new(const char *kind, const char *path)
 {
     char absolute[PATH_MAX];
     if (!realpath(path, absolute))
@@ -72,7 +72,7 @@ json_t *ingest_report_new(const char *kind, const char *path)
     return json_pack("{s:{s:s, s:s}}", "source", "kind", kind, "path", absolute);
 }
 
-vf_status ingest_make_images_dir(const char *out_dir, char *images_dir)
+vf_status vf__ingest_make_images_dir(const char *out_dir, char *images_dir)
 {
     vf_status status = vf_path_join(images_dir, VF_PATH_MAX, out_dir, INGEST_IMAGES);
     return status == VF_OK ? vf_mkdirs(images_dir) : status;
@@ -80,7 +80,7 @@ vf_status ingest_make_images_dir(const char *out_dir, char *images_dir)
 
 /* A plain write, without the fsync and rename of vf_write_file_atomic: frames are written
  * inside a staging folder that is swapped in whole only after the stage succeeded, and one
- * syncfs in ingest_finish replaces a sync per frame (which costs ~20 ms each, more than a
+ * syncfs in vf__ingest_finish replaces a sync per frame (which costs ~20 ms each, more than a
  * webcam's frame interval). */
 static vf_status write_bytes(const char *path, const unsigned char *bytes, size_t size)
 {
@@ -96,8 +96,8 @@ static vf_status write_bytes(const char *path, const unsigned char *bytes, size_
     return VF_OK;
 }
 
-vf_status ingest_save_frame(const char *images_dir, const char *name, const vf_rgb8 *frame,
-                            int max_size, int *width, int *height)
+vf_status vf__ingest_save_frame(const char *images_dir, const char *name, const vf_rgb8 *frame,
+                                int max_size, int *width, int *height)
 {
     char path[VF_PATH_MAX];
     vf_rgb8 small = {0, 0, NULL};
@@ -136,8 +136,8 @@ static json_t *rejections(const score_list *scores, const vf_selection *sel)
     return list;
 }
 
-vf_status ingest_select(const score_list *scores, const vf_select_params *params,
-                        const char *source, json_t *report, vf_selection *selection)
+vf_status vf__ingest_select(const score_list *scores, const vf_select_params *params,
+                            const char *source, json_t *report, vf_selection *selection)
 {
     vf_status status = vf_select_frames(scores->items, scores->count, params, selection);
     if (status != VF_OK)
@@ -169,9 +169,9 @@ vf_status ingest_select(const score_list *scores, const vf_select_params *params
     return VF_OK;
 }
 
-vf_status ingest_finish(json_t *report, json_t *files, int out_width, int out_height,
-                        const score_list *scores, const vf_selection *selection,
-                        const char *out_dir, json_t **out)
+vf_status vf__ingest_finish(json_t *report, json_t *files, int out_width, int out_height,
+                            const score_list *scores, const vf_selection *selection,
+                            const char *out_dir, json_t **out)
 {
     char path[VF_PATH_MAX];
     json_t *sharpness = json_array();

@@ -40,11 +40,11 @@ static vf_status capture(vf_v4l2 *cam, const vf_ingest_options *o, const char *c
             status = vf_score_frame(&frame, &score);
         if (status == VF_OK) {
             snprintf(name, sizeof name, "frame_%06d.jpg", scores->count);
-            status = ingest_save_frame(capture_dir, name, &frame, o->max_size, &stats->width,
-                                       &stats->height);
+            status = vf__ingest_save_frame(capture_dir, name, &frame, o->max_size, &stats->width,
+                                           &stats->height);
         }
         if (status == VF_OK)
-            status = score_list_push(scores, &score);
+            status = vf__score_list_push(scores, &score);
         if (status != VF_OK)
             break;
         if (scores->count > 1 && sequence - previous > 1)
@@ -115,11 +115,12 @@ vf_status vf_ingest_camera(const char *device, const vf_ingest_options *options,
     vf_selection sel = {0};
     capture_stats stats = {0};
     char capture_dir[VF_PATH_MAX], images_dir[VF_PATH_MAX];
-    json_t *report = ingest_report_new("camera", device), *files = json_array();
+    json_t *report = vf__ingest_report_new("camera", device), *files = json_array();
 
-    vf_status status = ingest_check_options(options);
+    vf_status status = vf__ingest_check_options(options);
     if (status == VF_OK && !(options->seconds > 0))
-        status = vf_fail(VF_EINPUT, "the capture time must be positive, not %g s", options->seconds);
+        status =
+            vf_fail(VF_EINPUT, "the capture time must be positive, not %g s", options->seconds);
     if (status == VF_OK)
         status = vf_path_join(capture_dir, sizeof capture_dir, out_dir, CAPTURE_DIR);
     if (status == VF_OK)
@@ -133,20 +134,20 @@ vf_status vf_ingest_camera(const char *device, const vf_ingest_options *options,
         json_object_set_new(report, "seconds", json_real(stats.seconds));
         json_object_set_new(report, "fps", json_real(scores.count / stats.seconds));
         json_object_set_new(report, "dropped", json_integer(stats.dropped));
-        status = ingest_select(&scores, &options->select, device, report, &sel);
+        status = vf__ingest_select(&scores, &options->select, device, report, &sel);
     }
     if (status == VF_OK)
-        status = ingest_make_images_dir(out_dir, images_dir);
+        status = vf__ingest_make_images_dir(out_dir, images_dir);
     if (status == VF_OK)
         status = keep_chosen(capture_dir, images_dir, &sel, files);
     if (status == VF_OK) {
-        status = ingest_finish(report, files, stats.width, stats.height, &scores, &sel, out_dir,
-                               report_out);
+        status = vf__ingest_finish(report, files, stats.width, stats.height, &scores, &sel,
+                                   out_dir, report_out);
         report = files = NULL;
     }
     json_decref(report);
     json_decref(files);
     vf_selection_free(&sel);
-    score_list_free(&scores);
+    vf__score_list_free(&scores);
     return status;
 }

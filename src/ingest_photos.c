@@ -86,7 +86,7 @@ static void output_name(const photo_list *list, int index, char *out, size_t siz
     snprintf(out, size, "%04d_%.200s.%s", index, stem, list->alpha[index] ? "png" : "jpg");
 }
 
-/* Write a photo with its alpha channel as PNG, shrunk as ingest_save_frame shrinks. */
+/* Write a photo with its alpha channel as PNG, shrunk as vf__ingest_save_frame shrinks. */
 static vf_status save_with_alpha(const char *path, const char *images_dir, const char *name,
                                  int max_size, int *width, int *height)
 {
@@ -127,8 +127,8 @@ static vf_status write_photos(const char *folder, const photo_list *list, const 
             s = save_with_alpha(path, images_dir, name, max_size, k ? NULL : width,
                                 k ? NULL : height);
         else if (s == VF_OK && (s = vf_rgb8_load(path, &photo)) == VF_OK)
-            s = ingest_save_frame(images_dir, name, &photo, max_size, k ? NULL : width,
-                                  k ? NULL : height);
+            s = vf__ingest_save_frame(images_dir, name, &photo, max_size, k ? NULL : width,
+                                      k ? NULL : height);
         vf_rgb8_free(&photo);
 #pragma omp critical
         if (s != VF_OK && status == VF_OK) {
@@ -175,7 +175,7 @@ vf_status vf_ingest_photos(const char *folder, const vf_ingest_options *options,
     int width = 0, height = 0, *sizes = NULL;
     json_t *report = NULL, *files = NULL;
 
-    vf_status status = ingest_check_options(options);
+    vf_status status = vf__ingest_check_options(options);
     if (status == VF_OK)
         status = list_photos(folder, &list);
     if (status != VF_OK)
@@ -189,15 +189,15 @@ vf_status vf_ingest_photos(const char *folder, const vf_ingest_options *options,
         status = score_photos(folder, &list, &scores, sizes);
     if (status == VF_OK) {
         vf_info("%s: %d photos", folder, list.count);
-        report = ingest_report_new("photos", folder);
+        report = vf__ingest_report_new("photos", folder);
         describe_photos(report, folder, &list, sizes);
         vf_select_params select = options->select;
         select.unordered = 1;
         select.blur_ratio = options->photo_blur_ratio;
-        status = ingest_select(&scores, &select, folder, report, &sel);
+        status = vf__ingest_select(&scores, &select, folder, report, &sel);
     }
     if (status == VF_OK)
-        status = ingest_make_images_dir(out_dir, images_dir);
+        status = vf__ingest_make_images_dir(out_dir, images_dir);
     if (status == VF_OK)
         status = write_photos(folder, &list, &sel, options->max_size, images_dir, &width, &height);
     if (status == VF_OK) {
@@ -207,12 +207,13 @@ vf_status vf_ingest_photos(const char *folder, const vf_ingest_options *options,
             output_name(&list, sel.chosen[k], name, sizeof name);
             json_array_append_new(files, json_string(name));
         }
-        status = ingest_finish(report, files, width, height, &scores, &sel, out_dir, report_out);
+        status =
+            vf__ingest_finish(report, files, width, height, &scores, &sel, out_dir, report_out);
         report = NULL;
     }
     json_decref(report);
     vf_selection_free(&sel);
-    score_list_free(&scores);
+    vf__score_list_free(&scores);
     free(sizes);
     photo_list_free(&list);
     return status;

@@ -20,7 +20,7 @@ static vf_status score_frames(vf_video *video, vf_rgb8 *frame, const vf_select_p
         vf_frame_score score;
         status = vf_score_frame(frame, &score);
         if (status == VF_OK)
-            status = score_list_push(scores, &score);
+            status = vf__score_list_push(scores, &score);
         if (status != VF_OK)
             break;
         char note[64];
@@ -83,8 +83,8 @@ static vf_status write_chosen(const char *path, const vf_selection *sel, int max
             continue;
         char name[32];
         snprintf(name, sizeof name, "frame_%06d.jpg", i);
-        status = ingest_save_frame(images_dir, name, &frame, max_size, next ? NULL : width,
-                                   next ? NULL : height);
+        status = vf__ingest_save_frame(images_dir, name, &frame, max_size, next ? NULL : width,
+                                       next ? NULL : height);
         json_array_append_new(files, json_string(name));
         vf_progress_update(&progress, (size_t)++next, NULL);
     }
@@ -119,25 +119,26 @@ vf_status vf_ingest_video(const char *path, const vf_ingest_options *options, co
     int width = 0, height = 0;
     json_t *report = NULL, *files = json_array();
 
-    vf_status status = ingest_check_options(options);
+    vf_status status = vf__ingest_check_options(options);
     if (status == VF_OK)
         status = score_video(path, &options->select, &info, &scores);
     if (status == VF_OK) {
-        report = ingest_report_new("video", path);
+        report = vf__ingest_report_new("video", path);
         describe_video(report, &info, scores.count);
-        status = ingest_select(&scores, &options->select, path, report, &sel);
+        status = vf__ingest_select(&scores, &options->select, path, report, &sel);
     }
     if (status == VF_OK)
-        status = ingest_make_images_dir(out_dir, images_dir);
+        status = vf__ingest_make_images_dir(out_dir, images_dir);
     if (status == VF_OK)
         status = write_chosen(path, &sel, options->max_size, images_dir, files, &width, &height);
     if (status == VF_OK) {
-        status = ingest_finish(report, files, width, height, &scores, &sel, out_dir, report_out);
+        status =
+            vf__ingest_finish(report, files, width, height, &scores, &sel, out_dir, report_out);
         report = files = NULL;
     }
     json_decref(report);
     json_decref(files);
     vf_selection_free(&sel);
-    score_list_free(&scores);
+    vf__score_list_free(&scores);
     return status;
 }

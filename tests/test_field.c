@@ -29,7 +29,7 @@ static vf_field *make_field(void)
     const int dim[3] = {12, 12, 12};
     const float lo[3] = {-1, -1, -1};
     float voxel = 2.0f / 11;
-    if (field_grid_alloc(&f->grids[0], dim, lo, voxel) != VF_OK)
+    if (vf__field_grid_alloc(&f->grids[0], dim, lo, voxel) != VF_OK)
         abort();
     f->grid_count = 1;
     field_grid *g = &f->grids[0];
@@ -50,7 +50,7 @@ static vf_field *make_field(void)
     /* 30 wide: rows are marched four rays at a time and two alone (render_march.c) */
     f->camera = (vf_camera){.width = 30, .height = 32, .fx = 40, .fy = 40, .cx = 15, .cy = 16};
     f->camera_distance = 4;
-    field_grid_update_occupancy(g, f, f->step_ratio * voxel);
+    vf__field_grid_update_occupancy(g, f, f->step_ratio * voxel);
     return f;
 }
 
@@ -75,7 +75,7 @@ static void test_alpha_table(void)
 {
     vf_field *f = make_field();
     field_render_setup setup;
-    field_render_setup_init(f, &setup);
+    vf__field_render_setup_init(f, &setup);
     const field_render_grid *r = &setup.grids[0];
     double worst = 0;
     for (float d = r->visible_density; d < r->visible_density + 60; d += 0.00731f) {
@@ -89,11 +89,13 @@ static void test_alpha_table(void)
     vf_field_free(f);
 }
 
-/* loss = g . rgb(ray) for a fixed g; its gradient by field_backward and by central differences. */
-static double ray_loss(const vf_field *f, const field_ray *ray, field_scratch *sc, const float g[3])
+/* loss = g . rgb(ray) for a fixed g; its gradient by vf__field_backward and by central
+ * differences. */
+static double ray_loss(const vf_field *f, const field_ray *ray, field_scratch *sc,
+                       const float g[3])
 {
     field_march_result res;
-    field_march(f, ray, 0.3f, 0.0f, sc, &res);
+    vf__field_march(f, ray, 0.3f, 0.0f, sc, &res);
     return (double)g[0] * res.rgb[0] + (double)g[1] * res.rgb[1] + (double)g[2] * res.rgb[2];
 }
 
@@ -101,8 +103,8 @@ static void test_gradients(void)
 {
     vf_field *f = make_field();
     field_grid *grid = &f->grids[0];
-    field_grid_fill_occupancy(grid); /* no skipping: the loss is smooth in every value */
-    field_scratch sc = {.capacity = field_max_samples(f)};
+    vf__field_grid_fill_occupancy(grid); /* no skipping: the loss is smooth in every value */
+    field_scratch sc = {.capacity = vf__field_max_samples(f)};
     sc.samples = malloc((size_t)sc.capacity * sizeof *sc.samples);
     field_grad_sink sink = {0};
     sink.grad[0] = calloc(grid->points * FIELD_CH, sizeof(float));
@@ -115,11 +117,11 @@ static void test_gradients(void)
         ray.dir[a] /= n;
     const float g[3] = {0.7f, -0.4f, 0.9f};
     field_march_result res;
-    field_march(f, &ray, 0.3f, 0.0f, &sc, &res);
+    vf__field_march(f, &ray, 0.3f, 0.0f, &sc, &res);
     CHECK(res.count > 10, "the test ray takes %d samples", res.count);
     CHECK(res.trans > 0.01f && res.trans < 0.99f, "the test ray is partly opaque (T = %g)",
           res.trans);
-    field_backward(f, &ray, &sc, &res, g, &sink);
+    vf__field_backward(f, &ray, &sc, &res, g, &sink);
     CHECK(sink.count[0] > 8, "the ray touched %zu points", sink.count[0]);
 
     int checked = 0, bad = 0;
@@ -173,8 +175,8 @@ static void test_render_matches_march(void)
         for (int x = 0; x < img.width; x++) {
             field_ray ray;
             field_march_result res;
-            field_camera_ray(&f->camera, c2w, x + 0.5, y + 0.5, &ray);
-            field_march(f, &ray, 0.5f, f->stop_transmittance, NULL, &res);
+            vf__field_camera_ray(&f->camera, c2w, x + 0.5, y + 0.5, &ray);
+            vf__field_march(f, &ray, 0.5f, f->stop_transmittance, NULL, &res);
             for (int k = 0; k < 3; k++) {
                 worst = fmax(worst, fabs(res.rgb[k] - img.data[3 * (y * img.width + x) + k]));
                 coloured = fmax(coloured, fabs(res.rgb[k] - 1.0f));
@@ -204,10 +206,10 @@ static vf_field *make_sparse_field(void)
 {
     vf_field *f = make_field();
     field_grid *g = &f->grids[0];
-    field_grid_free(g);
+    vf__field_grid_free(g);
     const int dim[3] = {48, 48, 48};
     const float lo[3] = {-1, -1, -1}, voxel = 2.0f / 47;
-    if (field_grid_alloc(g, dim, lo, voxel) != VF_OK)
+    if (vf__field_grid_alloc(g, dim, lo, voxel) != VF_OK)
         abort();
     const float centres[2][3] = {{-0.4f, 0.1f, 0.2f}, {0.5f, -0.3f, -0.1f}};
     for (size_t i = 0; i < g->points; i++) {
@@ -226,7 +228,7 @@ static vf_field *make_sparse_field(void)
             v[ch] = uniform(-1, 1);
     }
     f->density_scale = 1.0f / voxel;
-    field_grid_update_occupancy(g, f, f->step_ratio * voxel);
+    vf__field_grid_update_occupancy(g, f, f->step_ratio * voxel);
     return f;
 }
 
@@ -241,8 +243,8 @@ static int record_march(const vf_field *f, const double c2w[16], field_scratch *
         for (int x = 0; x < f->camera.width; x++) {
             field_ray ray;
             field_march_result res;
-            field_camera_ray(&f->camera, c2w, x + 0.5, y + 0.5, &ray);
-            field_march(f, &ray, 0.5f, 0.0f, sc, &res);
+            vf__field_camera_ray(&f->camera, c2w, x + 0.5, y + 0.5, &ray);
+            vf__field_march(f, &ray, 0.5f, 0.0f, sc, &res);
             for (int i = 0; i < res.count && n + 4 <= room; i++) {
                 const uint32_t p = sc->samples[i].base;
                 const size_t px = p % g->dim[0], py = p / g->dim[0] % g->dim[1];
@@ -273,7 +275,7 @@ static void test_jumps_skip_only_empty(void)
     const vf_viewpoint views[3] = {{.psi = 30, .theta = 10, .phi = 60},
                                    {.psi = -70, .theta = -35, .phi = 200, .dx = 0.3},
                                    {.psi = 5, .theta = 60, .phi = 130, .dz = -0.5}};
-    field_scratch sc = {.capacity = field_max_samples(f)};
+    field_scratch sc = {.capacity = vf__field_max_samples(f)};
     sc.samples = malloc((size_t)sc.capacity * sizeof *sc.samples);
     const int room = 1 << 20;
     float *recorded[2] = {malloc(room * sizeof(float)), malloc(room * sizeof(float))};
@@ -429,7 +431,7 @@ static void test_hostile_models(void)
     /* the renderer's opacity table takes any density, NaN included, without reading outside */
     f = make_field();
     field_render_setup setup;
-    field_render_setup_init(f, &setup);
+    vf__field_render_setup_init(f, &setup);
     const field_render_grid *r = &setup.grids[0];
     const float odd[5] = {NAN, INFINITY, -INFINITY, 3e38f, -3e38f};
     for (int i = 0; i < 5; i++) {
@@ -453,7 +455,7 @@ static void test_adam_small_team(void)
 {
     vf_field *f = make_field();
     field_adam adam = {0};
-    CHECK(field_adam_alloc(&adam, f, 2) == VF_OK, "adam for 2 threads");
+    CHECK(vf__field_adam_alloc(&adam, f, 2) == VF_OK, "adam for 2 threads");
     float lr[FIELD_CH];
     for (int ch = 0; ch < FIELD_CH; ch++)
         lr[ch] = 0.1f;
@@ -464,12 +466,12 @@ static void test_adam_small_team(void)
 #pragma omp parallel num_threads(2)
     {
 #pragma omp single
-        field_adam_step(&adam, f, lr, 0, 0); /* nested: a team of one */
+        vf__field_adam_step(&adam, f, lr, 0, 0); /* nested: a team of one */
     }
     CHECK(f->grids[0].values[a * FIELD_CH] < before_a - 0.05f, "sink 0 applied");
     CHECK(f->grids[0].values[b * FIELD_CH] < before_b - 0.05f, "sink 1 applied by a team of one");
-    CHECK(field_adam_touched(&adam) == 0, "sinks cleared");
-    field_adam_free(&adam);
+    CHECK(vf__field_adam_touched(&adam) == 0, "sinks cleared");
+    vf__field_adam_free(&adam);
     vf_field_free(f);
 }
 
@@ -557,7 +559,7 @@ static void test_empty_radius(void)
     field_grid g;
     const int dim[3] = {41, 31, 21}, occupied[2][3] = {{5, 7, 3}, {30, 20, 15}};
     const float lo[3] = {0, 0, 0};
-    CHECK(field_grid_alloc(&g, dim, lo, 1.0f) == VF_OK, "alloc");
+    CHECK(vf__field_grid_alloc(&g, dim, lo, 1.0f) == VF_OK, "alloc");
     const int nx = g.cells[0], ny = g.cells[1], nz = g.cells[2];
     size_t cells = (size_t)nx * ny * nz;
     memset(g.cell_bits, 0, (cells + 63) / 64 * 8);
@@ -567,7 +569,7 @@ static void test_empty_radius(void)
         g.cell_bits[c >> 6] |= 1ull << (c & 63);
     }
     uint8_t *scratch = malloc(cells);
-    field_grid_update_empty_radius(&g, scratch);
+    vf__field_grid_update_empty_radius(&g, scratch);
     int wrong = 0;
     for (int z = 0; z < nz; z++)
         for (int y = 0; y < ny; y++)
@@ -583,7 +585,7 @@ static void test_empty_radius(void)
             }
     CHECK(wrong == 0, "%d cells with a wrong empty-space radius", wrong);
     free(scratch);
-    field_grid_free(&g);
+    vf__field_grid_free(&g);
 }
 
 int main(void)

@@ -20,7 +20,7 @@ static void free_sink(field_grad_sink *s)
     memset(s, 0, sizeof *s);
 }
 
-void field_adam_free(field_adam *adam)
+void vf__field_adam_free(field_adam *adam)
 {
     for (int g = 0; g < FIELD_MAX_GRIDS; g++) {
         free(adam->m[g]);
@@ -32,9 +32,9 @@ void field_adam_free(field_adam *adam)
     memset(adam, 0, sizeof *adam);
 }
 
-vf_status field_adam_alloc(field_adam *adam, const vf_field *f, int threads)
+vf_status vf__field_adam_alloc(field_adam *adam, const vf_field *f, int threads)
 {
-    field_adam_free(adam);
+    vf__field_adam_free(adam);
     adam->beta1 = 0.9f;
     adam->beta2 = 0.99f;
     adam->eps = 1e-8f;
@@ -43,23 +43,23 @@ vf_status field_adam_alloc(field_adam *adam, const vf_field *f, int threads)
     int ok = adam->sinks != NULL;
     for (int g = 0; ok && g < f->grid_count; g++) {
         size_t n = f->grids[g].points;
-        ok &= (adam->m[g] = field_alloc(n * FIELD_CH * sizeof(float))) != NULL;
-        ok &= (adam->v[g] = field_alloc(n * FIELD_CH * sizeof(float))) != NULL;
+        ok &= (adam->m[g] = vf__field_alloc(n * FIELD_CH * sizeof(float))) != NULL;
+        ok &= (adam->v[g] = vf__field_alloc(n * FIELD_CH * sizeof(float))) != NULL;
         for (int i = 0; ok && i < threads; i++) {
             field_grad_sink *s = &adam->sinks[i];
-            ok &= (s->grad[g] = field_alloc(n * FIELD_CH * sizeof(float))) != NULL;
-            ok &= (s->touched[g] = field_alloc(n)) != NULL;
+            ok &= (s->grad[g] = vf__field_alloc(n * FIELD_CH * sizeof(float))) != NULL;
+            ok &= (s->touched[g] = vf__field_alloc(n)) != NULL;
             ok &= (s->list[g] = malloc(n * sizeof(uint32_t))) != NULL;
         }
     }
     if (!ok) {
-        field_adam_free(adam);
+        vf__field_adam_free(adam);
         return vf_fail(VF_EINTERNAL, "out of memory for the optimizer");
     }
     return VF_OK;
 }
 
-size_t field_adam_touched(const field_adam *adam)
+size_t vf__field_adam_touched(const field_adam *adam)
 {
     size_t n = 0;
     for (int g = 0; g < FIELD_MAX_GRIDS; g++)
@@ -115,8 +115,8 @@ static inline void adam_update(float *p, float *m, float *v, const float *grad,
     }
 }
 
-void field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
-                     float tv_color)
+void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
+                         float tv_color)
 {
     adam->t++;
     const float bc1 = 1.0f - powf(adam->beta1, (float)adam->t);

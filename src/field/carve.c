@@ -6,7 +6,7 @@
 #include "trainer_internal.h"
 #include "vf/log.h"
 
-void trainer_scene_center(const vf_field_trainer *t, double center[3], double *distance)
+void vf__trainer_scene_center(const vf_field_trainer *t, double center[3], double *distance)
 {
     /* The point nearest to every optical axis: sum_i (I - d_i d_i^T) (p - o_i) = 0. */
     double a[3][3] = {{0}}, b[3] = {0};
@@ -216,7 +216,7 @@ static vf_status grid_over(field_grid *g, const double lo[3], const double hi[3]
         /* centre the lattice on the box */
         lo_f[a] = (float)(0.5 * (lo[a] + hi[a]) - 0.5 * (dim[a] - 1) * voxel);
     }
-    return field_grid_alloc(g, dim, lo_f, (float)voxel);
+    return vf__field_grid_alloc(g, dim, lo_f, (float)voxel);
 }
 
 /* The spacing of level `level` when the finest spacing is `finest` (2x the points a level). */
@@ -225,10 +225,10 @@ static double level_voxel(const vf_field_trainer *t, double finest, int level)
     return finest * pow(2.0, (t->opt.levels - 1 - level) / 3.0);
 }
 
-vf_status trainer_build_grid(vf_field_trainer *t)
+vf_status vf__trainer_build_grid(vf_field_trainer *t)
 {
     double center[3], distance;
-    trainer_scene_center(t, center, &distance);
+    vf__trainer_scene_center(t, center, &distance);
     const vf_camera *cam = &t->views[0].camera;
     double tan_half = fmin(0.5 * cam->width / cam->fx, 0.5 * cam->height / cam->fy);
     double box_scale = t->opt.box_scale > 0 ? t->opt.box_scale : t->has_alpha ? 1.2 : 1.0;
@@ -294,7 +294,7 @@ vf_status trainer_build_grid(vf_field_trainer *t)
         f->grid_count = 2;
     }
     for (int i = 0; i < f->grid_count; i++)
-        field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
+        vf__field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
     return VF_OK;
 }
 
@@ -348,7 +348,7 @@ static void add_tiles(vf_field_trainer *t, const train_view *v, const uint8_t *u
         }
 }
 
-vf_status trainer_build_pool(vf_field_trainer *t)
+vf_status vf__trainer_build_pool(vf_field_trainer *t)
 {
     free(t->pool);
     t->pool = NULL;

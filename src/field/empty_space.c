@@ -27,7 +27,7 @@ static void min_max_pass(const uint8_t *in, uint8_t *out, int n, size_t stride)
     }
 }
 
-void field_grid_update_empty_radius(field_grid *g, uint8_t *scratch)
+void vf__field_grid_update_empty_radius(field_grid *g, uint8_t *scratch)
 {
     const int nx = g->cells[0], ny = g->cells[1], nz = g->cells[2];
     const size_t row = (size_t)nx, slice = row * (size_t)ny;

@@ -75,32 +75,29 @@ struct vf_field {
 
 /* Allocate a grid of dim points from lo with the given spacing; values zeroed, occupancy all
  * set. */
-vf_status field_grid_alloc(field_grid *g, const int dim[3], const float lo[3], float voxel);
-void field_grid_free(field_grid *g);
+vf_status vf__field_grid_alloc(field_grid *g, const int dim[3], const float lo[3], float voxel);
+void vf__field_grid_free(field_grid *g);
 
 /* Memory for big arrays: 64-byte aligned, zeroed, huge pages where the kernel offers them.
  * Release with free(). NULL when out of memory. */
-void *field_alloc(size_t bytes);
+void *vf__field_alloc(size_t bytes);
 
 /* Make `out` a grid over (at least) the same box with the new spacing, its values the
  * trilinear resampling of `src`. */
-vf_status field_grid_resample(const field_grid *src, float voxel, field_grid *out);
+vf_status vf__field_grid_resample(const field_grid *src, float voxel, field_grid *out);
 
 /* Recompute the occupancy of a grid from its densities: a cell is occupied when one of its
  * corners has alpha >= threshold for a step of step_world. */
-void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_world);
+void vf__field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_world);
 
 /* Set all occupancy bits (used before the densities mean anything). */
-void field_grid_fill_occupancy(field_grid *g);
+void vf__field_grid_fill_occupancy(field_grid *g);
 
 /* Recompute empty_radius from the occupancy bits; scratch holds one byte per cell. */
-void field_grid_update_empty_radius(field_grid *g, uint8_t *scratch);
+void vf__field_grid_update_empty_radius(field_grid *g, uint8_t *scratch);
 
 /* Plain comparisons: fminf/fmaxf keep NaN semantics and are library calls unless -ffast-math. */
-static inline float field_min(float a, float b)
-{
-    return a < b ? a : b;
-}
+static inline float field_min(float a, float b) { return a < b ? a : b; }
 
 static inline float field_max(float a, float b)
 {
@@ -149,10 +146,10 @@ static inline float field_lattice_skip(const field_lattice *l, float k, const fl
 
 /* The raw density d at which a step of step_world reaches opacity `alpha`: alpha >= threshold
  * exactly when d >= the value returned (softplus is monotonic). */
-float field_density_threshold(const vf_field *f, float alpha, float step_world);
+float vf__field_density_threshold(const vf_field *f, float alpha, float step_world);
 
 /* Number of occupied cells. */
-size_t field_grid_occupied_cells(const field_grid *g);
+size_t vf__field_grid_occupied_cells(const field_grid *g);
 
 static inline int field_cell_occupied(const field_grid *g, size_t cell)
 {
@@ -193,12 +190,12 @@ typedef struct field_march_result {
 } field_march_result;
 
 /* The largest number of samples a ray can take in the field. */
-int field_max_samples(const vf_field *f);
+int vf__field_max_samples(const vf_field *f);
 
 /* March one ray front to back. jitter (0..1) offsets the first sample within its step;
- * min_trans ends the ray early. With `rec` the samples are recorded for field_backward(). */
-void field_march(const vf_field *f, const field_ray *ray, float jitter, float min_trans,
-                 field_scratch *rec, field_march_result *out);
+ * min_trans ends the ray early. With `rec` the samples are recorded for vf__field_backward(). */
+void vf__field_march(const vf_field *f, const field_ray *ray, float jitter, float min_trans,
+                     field_scratch *rec, field_march_result *out);
 
 /* Where the gradient of one thread goes: dense per-grid gradient arrays the size of the values,
  * plus a list of the points touched since the last optimizer step (flag per point). */
@@ -211,11 +208,12 @@ typedef struct field_grad_sink {
 
 /* Accumulate dL/dvalues for one marched ray, given dL/drgb of its composited colour, into
  * the sink. `res` is the forward result of the same ray. */
-void field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
+void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
                     const field_march_result *res, const float dl_drgb[3], field_grad_sink *sink);
 
 /* Clip a ray to a box; returns 0 when it misses. */
-int field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], float *t0, float *t1);
+int vf__field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], float *t0,
+                      float *t1);
 
 /* A stretch [ta, tb) of a ray inside one grid; the march's lattice is anchored at ta. */
 typedef struct field_segment {
@@ -225,11 +223,11 @@ typedef struct field_segment {
 
 /* The segments of a ray in marching order: the outer grid in front of the inner box, the
  * inner box, the outer grid behind it. Returns how many (0 to 3). */
-int field_ray_segments(const vf_field *f, const field_ray *ray, field_segment out[3]);
+int vf__field_ray_segments(const vf_field *f, const field_ray *ray, field_segment out[3]);
 
 /* ---- render_march.c: rays forward only, as fast as they go ------------------------------ */
 
-/* Opacity of a step as a function of raw density, tabulated (see field_render_setup_init). */
+/* Opacity of a step as a function of raw density, tabulated (see vf__field_render_setup_init). */
 #define FIELD_ALPHA_TABLE 2048
 
 /* Per-grid constants of a render, computed once per image. */
@@ -246,7 +244,7 @@ typedef struct field_render_setup {
     field_render_grid grids[FIELD_MAX_GRIDS];
 } field_render_setup;
 
-void field_render_setup_init(const vf_field *f, field_render_setup *setup);
+void vf__field_render_setup_init(const vf_field *f, field_render_setup *setup);
 
 /* The opacity of a sample of raw density d >= visible_density, from the grid's table. The
  * index is clamped both ways (and a NaN takes the last entry), so no value can read outside
@@ -262,24 +260,22 @@ static inline float field_render_alpha(const field_render_grid *r, float d)
     return r->alpha[i] + (u - (float)i) * (r->alpha[i + 1] - r->alpha[i]);
 }
 
-/* The forward march of field_march without recording (same lattice of samples) for n rays,
+/* The forward march of vf__field_march without recording (same lattice of samples) for n rays,
  * for rendering: samples under FIELD_VISIBLE_ALPHA are skipped, rays are clipped to the
  * occupied cells, opacity comes from the setup's table (see render_march.c). */
-void field_render_rays(const vf_field *f, const field_render_setup *setup, const field_ray *rays,
-                       int n, float jitter, float min_trans, field_march_result *out);
+void vf__field_render_rays(const vf_field *f, const field_render_setup *setup,
+                           const field_ray *rays, int n, float jitter, float min_trans,
+                           field_march_result *out);
 
 /* ---- render.c: rays of a camera ------------------------------------------------------- */
 
 /* World-space ray through pixel centre (x + 0.5, y + 0.5) of a camera with camera-to-world
  * c2w (row-major, OpenGL axes). `unit_xy` is the undistorted normalized image point of the
  * pixel in OpenCV axes (x right, y down) or NULL for a pinhole computed from the camera. */
-void field_camera_ray(const vf_camera *cam, const double c2w[16], double x, double y,
-                      field_ray *ray);
+void vf__field_camera_ray(const vf_camera *cam, const double c2w[16], double x, double y,
+                          field_ray *ray);
 
-static inline float field_clamp01(float x)
-{
-    return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x;
-}
+static inline float field_clamp01(float x) { return x < 0.0f ? 0.0f : x > 1.0f ? 1.0f : x; }
 
 static inline float field_softplus(float x)
 {

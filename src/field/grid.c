@@ -5,7 +5,7 @@
 
 #include "field_internal.h"
 
-void *field_alloc(size_t bytes)
+void *vf__field_alloc(size_t bytes)
 {
     /* Big arrays are read at random by the ray marcher: 2 MiB alignment lets the kernel back
      * them with huge pages, which cuts TLB misses. */
@@ -27,7 +27,7 @@ static size_t bit_words(size_t bits)
     return (bits + 63) / 64;
 }
 
-vf_status field_grid_alloc(field_grid *g, const int dim[3], const float lo[3], float voxel)
+vf_status vf__field_grid_alloc(field_grid *g, const int dim[3], const float lo[3], float voxel)
 {
     memset(g, 0, sizeof *g);
     for (int a = 0; a < 3; a++) {
@@ -41,18 +41,18 @@ vf_status field_grid_alloc(field_grid *g, const int dim[3], const float lo[3], f
     g->voxel = voxel;
     g->points = (size_t)dim[0] * dim[1] * dim[2];
     size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2];
-    g->values = field_alloc(g->points * FIELD_CH * sizeof(float));
-    g->cell_bits = field_alloc(bit_words(cells) * sizeof(uint64_t));
-    g->empty_radius = field_alloc(cells);
+    g->values = vf__field_alloc(g->points * FIELD_CH * sizeof(float));
+    g->cell_bits = vf__field_alloc(bit_words(cells) * sizeof(uint64_t));
+    g->empty_radius = vf__field_alloc(cells);
     if (!g->values || !g->cell_bits || !g->empty_radius) {
-        field_grid_free(g);
+        vf__field_grid_free(g);
         return vf_fail(VF_EINTERNAL, "out of memory for a %dx%dx%d grid", dim[0], dim[1], dim[2]);
     }
-    field_grid_fill_occupancy(g);
+    vf__field_grid_fill_occupancy(g);
     return VF_OK;
 }
 
-void field_grid_free(field_grid *g)
+void vf__field_grid_free(field_grid *g)
 {
     free(g->values);
     free(g->cell_bits);
@@ -60,7 +60,7 @@ void field_grid_free(field_grid *g)
     memset(g, 0, sizeof *g);
 }
 
-void field_grid_fill_occupancy(field_grid *g)
+void vf__field_grid_fill_occupancy(field_grid *g)
 {
     size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2];
     memset(g->cell_bits, 0xff, bit_words(cells) * sizeof(uint64_t));
@@ -71,7 +71,7 @@ void field_grid_fill_occupancy(field_grid *g)
     }
 }
 
-size_t field_grid_occupied_cells(const field_grid *g)
+size_t vf__field_grid_occupied_cells(const field_grid *g)
 {
     size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2], count = 0;
     for (size_t w = 0; w < cells / 64; w++)
@@ -103,12 +103,12 @@ static void sample_point(const field_grid *g, const float u[3], float out[FIELD_
     }
 }
 
-vf_status field_grid_resample(const field_grid *src, float voxel, field_grid *out)
+vf_status vf__field_grid_resample(const field_grid *src, float voxel, field_grid *out)
 {
     int dim[3];
     for (int a = 0; a < 3; a++)
         dim[a] = (int)ceilf((src->hi[a] - src->lo[a]) / voxel - 1e-3f) + 1;
-    vf_status status = field_grid_alloc(out, dim, src->lo, voxel);
+    vf_status status = vf__field_grid_alloc(out, dim, src->lo, voxel);
     if (status != VF_OK)
         return status;
     float scale = voxel / src->voxel;
@@ -123,7 +123,7 @@ vf_status field_grid_resample(const field_grid *src, float voxel, field_grid *ou
     return VF_OK;
 }
 
-float field_density_threshold(const vf_field *f, float threshold, float step_world)
+float vf__field_density_threshold(const vf_field *f, float threshold, float step_world)
 {
     /* alpha = 1 - exp(-softplus(d + shift) * scale * step) */
     float sigma = -logf(1.0f - threshold) / (f->density_scale * step_world);
@@ -131,13 +131,13 @@ float field_density_threshold(const vf_field *f, float threshold, float step_wor
     return softplus_inv - f->density_shift;
 }
 
-void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_world)
+void vf__field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_world)
 {
-    float d_min = field_density_threshold(f, f->occupancy_alpha, step_world);
+    float d_min = vf__field_density_threshold(f, f->occupancy_alpha, step_world);
     size_t cells = (size_t)g->cells[0] * g->cells[1] * g->cells[2];
     uint8_t *point_on = malloc(g->points);
     if (!point_on) { /* cannot refine: keep everything occupied, which is always correct */
-        field_grid_fill_occupancy(g);
+        vf__field_grid_fill_occupancy(g);
         return;
     }
 #pragma omp parallel for schedule(static)
@@ -161,7 +161,7 @@ void field_grid_update_occupancy(field_grid *g, const vf_field *f, float step_wo
         }
         g->cell_bits[w] = word;
     }
-    field_grid_update_empty_radius(g, point_on); /* points > cells: room to spare */
+    vf__field_grid_update_empty_radius(g, point_on); /* points > cells: room to spare */
     free(point_on);
     for (int a = 0; a < 3; a++) {
         g->occ_lo[a] = g->cells[a];

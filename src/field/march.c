@@ -8,7 +8,8 @@
 
 #include "field_internal.h"
 
-int field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], float *t0, float *t1)
+int vf__field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], float *t0,
+                      float *t1)
 {
     float enter = ray->tmin, leave = ray->tmax;
     for (int a = 0; a < 3; a++) {
@@ -38,7 +39,7 @@ static float grid_step(const vf_field *f, const field_grid *g)
     return f->step_ratio * g->voxel;
 }
 
-int field_max_samples(const vf_field *f)
+int vf__field_max_samples(const vf_field *f)
 {
     double total = 4;
     for (int i = 0; i < f->grid_count; i++) {
@@ -153,15 +154,15 @@ static int march_segment(const vf_field *f, int gi, const field_ray *ray, float 
     }
 }
 
-int field_ray_segments(const vf_field *f, const field_ray *ray, field_segment out[3])
+int vf__field_ray_segments(const vf_field *f, const field_ray *ray, field_segment out[3])
 {
     int n = 0;
     float i0, i1, a0, a1;
-    const int hits_inner = field_ray_box(ray, f->grids[0].lo, f->grids[0].hi, &i0, &i1);
+    const int hits_inner = vf__field_ray_box(ray, f->grids[0].lo, f->grids[0].hi, &i0, &i1);
     if (f->grid_count == 1) {
         if (hits_inner)
             out[n++] = (field_segment){0, i0, i1};
-    } else if (field_ray_box(ray, f->grids[1].lo, f->grids[1].hi, &a0, &a1)) {
+    } else if (vf__field_ray_box(ray, f->grids[1].lo, f->grids[1].hi, &a0, &a1)) {
         if (!hits_inner) {
             out[n++] = (field_segment){1, a0, a1};
         } else {
@@ -175,13 +176,13 @@ int field_ray_segments(const vf_field *f, const field_ray *ray, field_segment ou
     return n;
 }
 
-void field_march(const vf_field *f, const field_ray *ray, float jitter, float min_trans,
-                 field_scratch *rec, field_march_result *out)
+void vf__field_march(const vf_field *f, const field_ray *ray, float jitter, float min_trans,
+                     field_scratch *rec, field_march_result *out)
 {
     march_state s = {.trans = 1.0f, .rec = rec};
     const float basis[4] = {1.0f, ray->dir[0], ray->dir[1], ray->dir[2]};
     field_segment seg[3];
-    const int n = field_ray_segments(f, ray, seg);
+    const int n = vf__field_ray_segments(f, ray, seg);
     for (int i = 0; i < n; i++)
         if (march_segment(f, seg[i].grid, ray, seg[i].ta, seg[i].tb, jitter, min_trans, basis, &s))
             break;
@@ -220,8 +221,9 @@ static inline void scatter(const vf_field *f, field_grad_sink *sink, const field
     }
 }
 
-void field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
-                    const field_march_result *res, const float dl_drgb[3], field_grad_sink *sink)
+void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
+                        const field_march_result *res, const float dl_drgb[3],
+                        field_grad_sink *sink)
 {
     const float basis[4] = {1.0f, ray->dir[0], ray->dir[1], ray->dir[2]};
     const float *g = dl_drgb;

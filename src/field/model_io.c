@@ -299,7 +299,7 @@ static vf_status read_model(stream *s, vf_field **out)
 
     vf_status status = VF_OK;
     for (int i = 0; status == VF_OK && i < f->grid_count; i++)
-        status = field_grid_alloc(&f->grids[i], h.dim[i], h.lo[i], h.voxel[i]);
+        status = vf__field_grid_alloc(&f->grids[i], h.dim[i], h.lo[i], h.voxel[i]);
     enum { CHUNK = 65536 };
     float *buf = status == VF_OK ? malloc((size_t)CHUNK * FIELD_CH_USED * sizeof(float)) : NULL;
     if (status == VF_OK && !buf)
@@ -336,7 +336,7 @@ static vf_status read_model(stream *s, vf_field **out)
 static void refresh_occupancy(vf_field *f)
 {
     for (int i = 0; i < f->grid_count; i++)
-        field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
+        vf__field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
 }
 
 vf_status vf_field_save(const vf_field *f, const char *path)
@@ -393,7 +393,7 @@ vf_status vf_field_trainer_save_checkpoint(const vf_field_trainer *t, const char
         return vf_fail(VF_EINTERNAL, "nothing to checkpoint");
     checkpoint_state st;
     memset(&st, 0, sizeof st);
-    st.fingerprint = trainer_views_fingerprint(t);
+    st.fingerprint = vf__trainer_views_fingerprint(t);
     st.options_size = sizeof st.options;
     st.options = t->opt;
     st.step = t->step;
@@ -423,7 +423,7 @@ vf_status vf_field_trainer_save_checkpoint(const vf_field_trainer *t, const char
     return finish_write(&s, tmp);
 }
 
-vf_status trainer_checkpoint_read(vf_field_trainer *t, const char *path)
+vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
 {
     stream s;
     vf_status status = open_for_read(&s, path);
@@ -443,7 +443,7 @@ vf_status trainer_checkpoint_read(vf_field_trainer *t, const char *path)
         get(&s, &st, sizeof st);
         if (s.failed || st.options_size != sizeof st.options)
             status = vf_fail(VF_EINPUT, "%s is truncated or from another build", path);
-        else if (st.fingerprint != trainer_views_fingerprint(t))
+        else if (st.fingerprint != vf__trainer_views_fingerprint(t))
             status = vf_fail(VF_EINPUT, "%s was made from other training images or poses", path);
         else if (st.options.seconds != t->opt.seconds || st.options.steps != t->opt.steps ||
                  st.options.keep_background != t->opt.keep_background)
@@ -473,7 +473,7 @@ vf_status trainer_checkpoint_read(vf_field_trainer *t, const char *path)
     t->rng = st.rng;
     t->elapsed_before = st.elapsed;
     refresh_occupancy(f);
-    status = field_adam_alloc(&t->adam, f, t->threads);
+    status = vf__field_adam_alloc(&t->adam, f, t->threads);
     for (int i = 0; status == VF_OK && i < f->grid_count; i++) {
         size_t bytes = f->grids[i].points * FIELD_CH * sizeof(float);
         get(&s, t->adam.m[i], bytes);

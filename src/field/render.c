@@ -5,8 +5,8 @@
 
 #include "field_internal.h"
 
-void field_camera_ray(const vf_camera *cam, const double c2w[16], double x, double y,
-                      field_ray *ray)
+void vf__field_camera_ray(const vf_camera *cam, const double c2w[16], double x, double y,
+                          field_ray *ray)
 {
     double d_cv[3]; /* OpenCV camera axes: x right, y down, z forward */
     if (vf_camera_has_distortion(cam)) {
@@ -64,7 +64,7 @@ static vf_status check_poses(const double *c2w, int n)
 static void render_rows(const vf_field *f, const field_render_setup *setup, const vf_camera *cam,
                         const double c2w[16], float *rgb, int parallel)
 {
-    enum { RUN = 64 }; /* pixels of a row marched together (field_render_rays) */
+    enum { RUN = 64 }; /* pixels of a row marched together (vf__field_render_rays) */
     const int width = cam->width, height = cam->height;
 #pragma omp parallel for schedule(dynamic, 2) if (parallel)
     for (int y = 0; y < height; y++) {
@@ -73,8 +73,8 @@ static void render_rows(const vf_field *f, const field_render_setup *setup, cons
             field_ray rays[RUN];
             field_march_result res[RUN];
             for (int j = 0; j < n; j++)
-                field_camera_ray(cam, c2w, x0 + j + 0.5, y + 0.5, &rays[j]);
-            field_render_rays(f, setup, rays, n, 0.5f, f->stop_transmittance, res);
+                vf__field_camera_ray(cam, c2w, x0 + j + 0.5, y + 0.5, &rays[j]);
+            vf__field_render_rays(f, setup, rays, n, 0.5f, f->stop_transmittance, res);
             for (int j = 0; j < n; j++) {
                 const size_t i = (size_t)y * width + x0 + j;
                 memcpy(rgb + 3 * i, res[j].rgb, sizeof res[j].rgb);
@@ -87,7 +87,7 @@ static void render_rows(const vf_field *f, const field_render_setup *setup, cons
 static void render_one(const vf_field *f, const vf_camera *cam, const double c2w[16], float *rgb)
 {
     field_render_setup setup;
-    field_render_setup_init(f, &setup);
+    vf__field_render_setup_init(f, &setup);
     render_rows(f, &setup, cam, c2w, rgb, 1);
 }
 
@@ -115,7 +115,7 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
     if (status != VF_OK)
         return status;
     field_render_setup setup;
-    field_render_setup_init(f, &setup);
+    vf__field_render_setup_init(f, &setup);
     /* Small images: one image per thread keeps each core on its own memory; otherwise split
      * every image's rows. */
     if ((size_t)cam->width * cam->height <= 512 * 512 && n > 1) {
@@ -176,7 +176,7 @@ void vf_field_get_info(const vf_field *f, vf_field_info *info)
         const field_grid *gi = &f->grids[i];
         size_t cells = (size_t)gi->cells[0] * gi->cells[1] * gi->cells[2];
         info->points += gi->points;
-        info->occupied_cells += field_grid_occupied_cells(gi);
+        info->occupied_cells += vf__field_grid_occupied_cells(gi);
         info->bytes += gi->points * FIELD_CH * sizeof(float) + cells / 8 + cells;
     }
 }
@@ -186,6 +186,6 @@ void vf_field_free(vf_field *f)
     if (!f)
         return;
     for (int i = 0; i < f->grid_count; i++)
-        field_grid_free(&f->grids[i]);
+        vf__field_grid_free(&f->grids[i]);
     free(f);
 }

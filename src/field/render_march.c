@@ -1,6 +1,6 @@
-/* The rendering ray marcher: field_march's forward pass, lean.
+/* The rendering ray marcher: vf__field_march's forward pass, lean.
  *
- * It visits the same lattice of samples as field_march (t_k = t_start + (k + jitter) * step
+ * It visits the same lattice of samples as vf__field_march (t_k = t_start + (k + jitter) * step
  * from the grid box entry), so renders agree with what training optimized, but:
  *   - the ray is clipped to the box of occupied cells and starts at the first lattice point
  *     inside it;
@@ -36,7 +36,7 @@ static void tabulate_alpha(const vf_field *f, field_render_grid *r)
     }
 }
 
-void field_render_setup_init(const vf_field *f, field_render_setup *setup)
+void vf__field_render_setup_init(const vf_field *f, field_render_setup *setup)
 {
     memset(setup, 0, sizeof *setup);
     for (int i = 0; i < f->grid_count; i++) {
@@ -44,7 +44,7 @@ void field_render_setup_init(const vf_field *f, field_render_setup *setup)
         field_render_grid *r = &setup->grids[i];
         r->step = f->step_ratio * g->voxel;
         r->scale_step = f->density_scale * r->step;
-        r->visible_density = field_density_threshold(f, FIELD_VISIBLE_ALPHA, r->step);
+        r->visible_density = vf__field_density_threshold(f, FIELD_VISIBLE_ALPHA, r->step);
         tabulate_alpha(f, r);
         r->empty = 0;
         for (int a = 0; a < 3; a++) {
@@ -96,7 +96,7 @@ static inline fast_f4 sample_colour(point_f16 point, point_f16 basis)
     return fast_sigmoid4((b0 + b1) + (b2 + b3));
 }
 
-/* A ray being marched: its segments (field_ray_segments), the one being marched and the
+/* A ray being marched: its segments (vf__field_ray_segments), the one being marched and the
  * compositing so far. */
 typedef struct ray_cursor {
     const field_ray *ray;
@@ -128,7 +128,7 @@ static __attribute__((noinline)) void cursor_start_segment(ray_cursor *c, const 
         clipped.tmin = sg->ta;
         clipped.tmax = sg->tb;
         float c0, c1;
-        if (!field_ray_box(&clipped, rg->occ_lo, rg->occ_hi, &c0, &c1))
+        if (!vf__field_ray_box(&clipped, rg->occ_lo, rg->occ_hi, &c0, &c1))
             continue;
         const field_grid *g = &f->grids[sg->grid];
         const float step = rg->step;
@@ -157,7 +157,7 @@ static void cursor_init(ray_cursor *c, const vf_field *f, const field_render_set
     c->state = (render_state){.trans = 1.0f};
     const float x = ray->dir[0], y = ray->dir[1], z = ray->dir[2];
     c->basis = (point_f16){0, 1, x, y, z, 1, x, y, z, 1, x, y, z, 0, 0, 0};
-    c->segment_count = field_ray_segments(f, ray, c->segments);
+    c->segment_count = vf__field_ray_segments(f, ray, c->segments);
     c->segment = 0;
     c->alive = 1;
     cursor_start_segment(c, f, setup);
@@ -230,8 +230,9 @@ static void cursor_finish(const ray_cursor *c, const vf_field *f, field_march_re
 
 enum { LANES = 4 }; /* rays marched in turn: 2 were 12% faster than 1, 4 another 5%, 8 slower */
 
-void field_render_rays(const vf_field *f, const field_render_setup *setup, const field_ray *rays,
-                       int n, float jitter, float min_trans, field_march_result *out)
+void vf__field_render_rays(const vf_field *f, const field_render_setup *setup,
+                           const field_ray *rays, int n, float jitter, float min_trans,
+                           field_march_result *out)
 {
     int first = 0;
     for (; first + LANES <= n; first += LANES) {

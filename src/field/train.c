@@ -67,8 +67,8 @@ void vf_field_trainer_free(vf_field_trainer *t)
 {
     if (!t)
         return;
-    trainer_views_free(t);
-    field_adam_free(&t->adam);
+    vf__trainer_views_free(t);
+    vf__field_adam_free(&t->adam);
     for (int i = 0; t->scratch && i < t->threads; i++)
         free(t->scratch[i].samples);
     free(t->scratch);
@@ -94,7 +94,7 @@ static vf_status alloc_scratch(vf_field_trainer *t)
 {
     if (!t->scratch && !(t->scratch = calloc((size_t)t->threads, sizeof *t->scratch)))
         return vf_fail(VF_EINTERNAL, "out of memory");
-    int capacity = field_max_samples(t->field);
+    int capacity = vf__field_max_samples(t->field);
     for (int i = 0; i < t->threads; i++) {
         free(t->scratch[i].samples);
         t->scratch[i].samples = malloc((size_t)capacity * sizeof(field_sample));
@@ -110,8 +110,8 @@ static vf_status prepare_level(vf_field_trainer *t)
 {
     vf_field *f = t->field;
     for (int i = 0; i < f->grid_count; i++)
-        field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
-    vf_status status = field_adam_alloc(&t->adam, f, t->threads);
+        vf__field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
+    vf_status status = vf__field_adam_alloc(&t->adam, f, t->threads);
     if (status == VF_OK)
         status = alloc_scratch(t);
     return status;
@@ -125,9 +125,9 @@ vf_status vf_field_trainer_start(vf_field_trainer *t)
         return vf_fail(VF_EINPUT, "no training views");
     t->started = 1;
     t->start_time = vf_now();
-    vf_status status = trainer_build_grid(t);
+    vf_status status = vf__trainer_build_grid(t);
     if (status == VF_OK)
-        status = trainer_build_pool(t);
+        status = vf__trainer_build_pool(t);
     if (status == VF_OK)
         status = prepare_level(t);
     return status;
@@ -139,9 +139,9 @@ vf_status vf_field_trainer_resume(vf_field_trainer *t, const char *path)
         return vf_fail(VF_EINTERNAL, "training already started");
     if (t->view_count == 0)
         return vf_fail(VF_EINPUT, "no training views");
-    vf_status status = trainer_checkpoint_read(t, path);
+    vf_status status = vf__trainer_checkpoint_read(t, path);
     if (status == VF_OK)
-        status = trainer_build_pool(t);
+        status = vf__trainer_build_pool(t);
     if (status == VF_OK)
         status = alloc_scratch(t);
     if (status != VF_OK)
@@ -207,13 +207,13 @@ static vf_status upsample(vf_field_trainer *t)
         /* the outer grid keeps its ratio to the inner one */
         float level_voxel = (float)(i == 0 ? t->final_voxel * factor
                                            : f->grids[i].voxel / pow(2.0, 1.0 / 3.0));
-        vf_status status = field_grid_resample(&f->grids[i], level_voxel, &finer);
+        vf_status status = vf__field_grid_resample(&f->grids[i], level_voxel, &finer);
         if (status != VF_OK)
             return status;
-        field_grid_free(&f->grids[i]);
+        vf__field_grid_free(&f->grids[i]);
         f->grids[i] = finer;
     }
-    field_adam_free(&t->adam);
+    vf__field_adam_free(&t->adam);
     return prepare_level(t);
 }
 
@@ -224,7 +224,7 @@ static int draw_batch(vf_field_trainer *t, uint32_t *pixels, float *jitter, int 
     int count = 0;
     while (count + TRAIN_TILE * TRAIN_TILE <= n) {
         uint32_t corner = t->pool[vf_rng_below(&t->rng, t->pool_size)];
-        const train_view *v = &t->views[trainer_pixel_view(t, corner)];
+        const train_view *v = &t->views[vf__trainer_pixel_view(t, corner)];
         const int w = v->camera.width, h = v->camera.height;
         size_t local = corner - v->first_pixel;
         int x0 = (int)(local % (size_t)w), y0 = (int)(local / (size_t)w);
@@ -253,8 +253,8 @@ static double run_batch(vf_field_trainer *t, const uint32_t *pixels, const float
         field_ray ray;
         float target[3];
         field_march_result res;
-        trainer_pixel_ray(t, pixels[i], &ray, target);
-        field_march(f, &ray, jitter[i], 1e-4f, &t->scratch[me], &res);
+        vf__trainer_pixel_ray(t, pixels[i], &ray, target);
+        vf__field_march(f, &ray, jitter[i], 1e-4f, &t->scratch[me], &res);
         float dl[3];
         for (int k = 0; k < 3; k++) {
             float err = res.rgb[k] - target[k];
@@ -262,7 +262,7 @@ static double run_batch(vf_field_trainer *t, const uint32_t *pixels, const float
             dl[k] = loss_scale * err;
         }
         if (res.count)
-            field_backward(f, &ray, &t->scratch[me], &res, dl, &t->adam.sinks[me]);
+            vf__field_backward(f, &ray, &t->scratch[me], &res, dl, &t->adam.sinks[me]);
         total += res.count;
     }
     *samples = total;
@@ -288,7 +288,7 @@ static void fill_status(const vf_field_trainer *t, vf_field_train_status *s)
     s->touched_points = t->last_touched;
     if (t->field) {
         const field_grid *g = &t->field->grids[0];
-        s->occupied = (double)field_grid_occupied_cells(g) /
+        s->occupied = (double)vf__field_grid_occupied_cells(g) /
                       ((double)g->cells[0] * g->cells[1] * g->cells[2]);
     }
     s->done = t->done;
@@ -313,7 +313,7 @@ vf_status vf_field_trainer_step(vf_field_trainer *t, vf_field_train_status *stat
     if (t->step % OCCUPANCY_EVERY == 0 && t->step > 0) {
         f->occupancy_alpha = occupancy_alpha_at(t, fraction);
         for (int i = 0; i < f->grid_count; i++)
-            field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
+            vf__field_grid_update_occupancy(&f->grids[i], f, f->step_ratio * f->grids[i].voxel);
     }
 
     const int n = t->opt.batch_rays;
@@ -338,8 +338,8 @@ vf_status vf_field_trainer_step(vf_field_trainer *t, vf_field_train_status *stat
     lr[FIELD_CH_DENSITY] = t->opt.lr_density * decay;
     for (int ch = FIELD_CH_SH; ch < FIELD_CH_USED; ch++)
         lr[ch] = t->opt.lr_color * decay;
-    t->last_touched = (double)field_adam_touched(&t->adam);
-    field_adam_step(&t->adam, f, lr, t->opt.tv_density, t->opt.tv_color);
+    t->last_touched = (double)vf__field_adam_touched(&t->adam);
+    vf__field_adam_step(&t->adam, f, lr, t->opt.tv_density, t->opt.tv_color);
     t->last_samples_per_ray = (double)samples / rays;
     t->last_step_ms = (t1 - t0) * 1000;
     t->last_optimizer_ms = (vf_now() - t1) * 1000;

@@ -112,7 +112,7 @@ vf_status vf_field_trainer_add_view(vf_field_trainer *t, const vf_camera *cam, c
     return VF_OK;
 }
 
-int trainer_pixel_view(const vf_field_trainer *t, size_t p)
+int vf__trainer_pixel_view(const vf_field_trainer *t, size_t p)
 {
     int lo = 0, hi = t->view_count - 1;
     while (lo < hi) { /* the last view whose first pixel is <= p */
@@ -125,9 +125,9 @@ int trainer_pixel_view(const vf_field_trainer *t, size_t p)
     return lo;
 }
 
-void trainer_pixel_ray(const vf_field_trainer *t, size_t p, field_ray *ray, float rgb[3])
+void vf__trainer_pixel_ray(const vf_field_trainer *t, size_t p, field_ray *ray, float rgb[3])
 {
-    const train_view *v = &t->views[trainer_pixel_view(t, p)];
+    const train_view *v = &t->views[vf__trainer_pixel_view(t, p)];
     const float *xy = t->tables[v->table].xy + 2 * (p - v->first_pixel);
     const double d_gl[3] = {xy[0], -xy[1], -1.0}; /* OpenCV (x, y, 1) to OpenGL axes */
     const double *m = v->c2w;
@@ -154,7 +154,7 @@ static uint64_t fnv1a(uint64_t h, const void *data, size_t size)
     return h;
 }
 
-uint64_t trainer_views_fingerprint(const vf_field_trainer *t)
+uint64_t vf__trainer_views_fingerprint(const vf_field_trainer *t)
 {
     uint64_t h = 0xcbf29ce484222325ull;
     h = fnv1a(h, &t->view_count, sizeof t->view_count);
@@ -168,7 +168,7 @@ uint64_t trainer_views_fingerprint(const vf_field_trainer *t)
     return h;
 }
 
-void trainer_views_free(vf_field_trainer *t)
+void vf__trainer_views_free(vf_field_trainer *t)
 {
     for (int i = 0; i < t->view_count; i++)
         free(t->views[i].mask);

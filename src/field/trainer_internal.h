@@ -79,49 +79,49 @@ struct vf_field_trainer {
 /* ---- train_views.c -------------------------------------------------------------------- */
 
 /* The ray through pixel `p` (global pixel index) and its target colour. */
-void trainer_pixel_ray(const vf_field_trainer *t, size_t p, field_ray *ray, float rgb[3]);
+void vf__trainer_pixel_ray(const vf_field_trainer *t, size_t p, field_ray *ray, float rgb[3]);
 
 /* Which view a global pixel index belongs to. */
-int trainer_pixel_view(const vf_field_trainer *t, size_t p);
+int vf__trainer_pixel_view(const vf_field_trainer *t, size_t p);
 
 /* A fingerprint of the views (sizes, cameras, poses, pixels) so a checkpoint can tell it is
  * resumed on the same data. */
-uint64_t trainer_views_fingerprint(const vf_field_trainer *t);
+uint64_t vf__trainer_views_fingerprint(const vf_field_trainer *t);
 
-void trainer_views_free(vf_field_trainer *t);
+void vf__trainer_views_free(vf_field_trainer *t);
 
 /* ---- carve.c ------------------------------------------------------------------------- */
 
 /* Where the cameras look (the point nearest all optical axes) and their mean distance to it. */
-void trainer_scene_center(const vf_field_trainer *t, double center[3], double *distance);
+void vf__trainer_scene_center(const vf_field_trainer *t, double center[3], double *distance);
 
 /* Build the object grid: place the box, carve it with the views' alpha masks (visual hull),
  * shrink the box to what is left, and fill the grid at the coarsest level. */
-vf_status trainer_build_grid(vf_field_trainer *t);
+vf_status vf__trainer_build_grid(vf_field_trainer *t);
 
 /* The pixels whose rays pass through occupied space (for views with alpha); all pixels of
  * opaque views. */
-vf_status trainer_build_pool(vf_field_trainer *t);
+vf_status vf__trainer_build_pool(vf_field_trainer *t);
 
 /* ---- model_io.c ---------------------------------------------------------------------- */
 
 /* Load a checkpoint's field, optimizer state and schedule position into t (views already
  * added; pool and scratch are left to the caller). */
-vf_status trainer_checkpoint_read(vf_field_trainer *t, const char *path);
+vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path);
 
 /* ---- adam.c -------------------------------------------------------------------------- */
 
 /* Allocate moments and per-thread gradient sinks for the field's current grids. */
-vf_status field_adam_alloc(field_adam *adam, const vf_field *f, int threads);
-void field_adam_free(field_adam *adam);
+vf_status vf__field_adam_alloc(field_adam *adam, const vf_field *f, int threads);
+void vf__field_adam_free(field_adam *adam);
 
 /* Apply one Adam step to every point touched since the last step, summing the threads'
  * gradients (plus total variation when weights are non-zero), then clear the sinks.
  * lr[ch] is the learning rate of channel ch. */
-void field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
-                     float tv_color);
+void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
+                         float tv_color);
 
 /* Number of distinct points touched (for statistics). */
-size_t field_adam_touched(const field_adam *adam);
+size_t vf__field_adam_touched(const field_adam *adam);
 
 #endif

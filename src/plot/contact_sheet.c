@@ -10,7 +10,8 @@
 #define CAPTION_HEIGHT 36
 #define GAP 4
 
-void plot_text(cairo_t *cr, double x, double y, double size, const char *text, plot_align align)
+void vf__plot_text(cairo_t *cr, double x, double y, double size, const char *text,
+                   plot_align align)
 {
     cairo_text_extents_t ext;
     cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
@@ -23,7 +24,7 @@ void plot_text(cairo_t *cr, double x, double y, double size, const char *text, p
     cairo_show_text(cr, text);
 }
 
-vf_status plot_finish(cairo_surface_t *surface, cairo_t *cr, const char *path)
+vf_status vf__plot_finish(cairo_surface_t *surface, cairo_t *cr, const char *path)
 {
     cairo_surface_flush(surface);
     cairo_status_t st = cairo_status(cr);
@@ -88,8 +89,8 @@ vf_status vf_contact_sheet(const char *path, const vf_image *images, const char 
         snprintf(line[0], sizeof line[0], "%.*s", nl ? (int)(nl - text) : (int)strlen(text), text);
         if (nl)
             snprintf(line[1], sizeof line[1], "%s", nl + 1);
-        plot_text(cr, x + 4, y + th + 15, 11, line[0], PLOT_ALIGN_LEFT);
-        plot_text(cr, x + 4, y + th + 30, 11, line[1], PLOT_ALIGN_LEFT);
+        vf__plot_text(cr, x + 4, y + th + 15, 11, line[0], PLOT_ALIGN_LEFT);
+        vf__plot_text(cr, x + 4, y + th + 30, 11, line[1], PLOT_ALIGN_LEFT);
     }
-    return plot_finish(surface, cr, path);
+    return vf__plot_finish(surface, cr, path);
 }

@@ -62,7 +62,7 @@ static void draw_axes(cairo_t *cr, const vf_plot_axes *axes, double x0, double x
         cairo_stroke(cr);
         snprintf(text, sizeof text, "%g", fabs(t) < 1e-12 * ys ? 0.0 : t);
         cairo_set_source_rgb(cr, 0, 0, 0);
-        plot_text(cr, LEFT - 8, py + 4, 12, text, PLOT_ALIGN_RIGHT);
+        vf__plot_text(cr, LEFT - 8, py + 4, 12, text, PLOT_ALIGN_RIGHT);
     }
     for (double t = ceil(x0 / xs) * xs; t <= x1 + 1e-9 * xs; t += xs) {
         double px = LEFT + pw * (t - x0) / (x1 - x0);
@@ -72,18 +72,18 @@ static void draw_axes(cairo_t *cr, const vf_plot_axes *axes, double x0, double x
         cairo_stroke(cr);
         snprintf(text, sizeof text, "%g", t);
         cairo_set_source_rgb(cr, 0, 0, 0);
-        plot_text(cr, px, TOP + ph + 18, 12, text, PLOT_ALIGN_CENTRE);
+        vf__plot_text(cr, px, TOP + ph + 18, 12, text, PLOT_ALIGN_CENTRE);
     }
     cairo_set_source_rgb(cr, 0, 0, 0);
     cairo_rectangle(cr, LEFT, TOP, pw, ph);
     cairo_stroke(cr);
-    plot_text(cr, WIDTH / 2.0, 30, 16, axes->title ? axes->title : "", PLOT_ALIGN_CENTRE);
-    plot_text(cr, LEFT + pw / 2, HEIGHT - 15, 13, axes->x_label ? axes->x_label : "",
-              PLOT_ALIGN_CENTRE);
+    vf__plot_text(cr, WIDTH / 2.0, 30, 16, axes->title ? axes->title : "", PLOT_ALIGN_CENTRE);
+    vf__plot_text(cr, LEFT + pw / 2, HEIGHT - 15, 13, axes->x_label ? axes->x_label : "",
+                  PLOT_ALIGN_CENTRE);
     cairo_save(cr);
     cairo_translate(cr, 22, TOP + ph / 2);
     cairo_rotate(cr, -M_PI / 2);
-    plot_text(cr, 0, 0, 13, axes->y_label ? axes->y_label : "", PLOT_ALIGN_CENTRE);
+    vf__plot_text(cr, 0, 0, 13, axes->y_label ? axes->y_label : "", PLOT_ALIGN_CENTRE);
     cairo_restore(cr);
 }
 
@@ -139,8 +139,8 @@ vf_status vf_plot_lines(const char *path, const vf_plot_axes *axes, const vf_plo
             cairo_rectangle(cr, WIDTH - RIGHT - 180, ly - 9, 20, 4);
             cairo_fill(cr);
             cairo_set_source_rgb(cr, 0, 0, 0);
-            plot_text(cr, WIDTH - RIGHT - 152, ly - 3, 12, series[k].name, PLOT_ALIGN_LEFT);
+            vf__plot_text(cr, WIDTH - RIGHT - 152, ly - 3, 12, series[k].name, PLOT_ALIGN_LEFT);
         }
     }
-    return plot_finish(surface, cr, path);
+    return vf__plot_finish(surface, cr, path);
 }

@@ -139,8 +139,8 @@ vf_status vf_attack_step(vf_attack_state *st, const vf_attack_config *cfg,
     if (st->components != cfg->components)
         return vf_fail(VF_EINPUT, "the attack state has %d mixture components but the config "
                        "asks for %d", st->components, cfg->components);
-    return cfg->method == VF_ATTACK_PEPG ? pepg_step(st, cfg, loss_fn, ctx)
-                                         : nes_step(st, cfg, loss_fn, ctx);
+    return cfg->method == VF_ATTACK_PEPG ? vf__pepg_step(st, cfg, loss_fn, ctx)
+                                         : vf__nes_step(st, cfg, loss_fn, ctx);
 }
 
 vf_status vf_attack_run(vf_attack_state *st, const vf_attack_config *cfg,
@@ -175,7 +175,8 @@ vf_status vf_attack_estimate_gradient(const vf_attack_state *st, const vf_attack
     if (!views || !losses || !fooled)
         status = vf_fail(VF_EINTERNAL, "out of memory for %d attack samples", k);
     else
-        status = nes_gradient(st, cfg, loss_fn, ctx, rng, grad, views, losses, fooled, &entropy);
+        status =
+            vf__nes_gradient(st, cfg, loss_fn, ctx, rng, grad, views, losses, fooled, &entropy);
     free(views);
     free(losses);
     free(fooled);
@@ -184,8 +185,8 @@ vf_status vf_attack_estimate_gradient(const vf_attack_state *st, const vf_attack
 
 /* ---- helpers shared by the methods ---- */
 
-double mixture_log_density(const vf_attack_state *st, const double u[VF_VIEW_DIM],
-                           double *resp)
+double vf__mixture_log_density(const vf_attack_state *st, const double u[VF_VIEW_DIM],
+                               double *resp)
 {
     double pi[VF_ATTACK_MAX_COMPONENTS], logp[VF_ATTACK_MAX_COMPONENTS], top = -INFINITY;
     vf_attack_weights(st, pi);
@@ -210,8 +211,8 @@ double mixture_log_density(const vf_attack_state *st, const double u[VF_VIEW_DIM
     return log_density;
 }
 
-vf_status evaluate_batch(vf_attack_loss_fn loss_fn, void *ctx, const double *views, int n,
-                         double *losses, int *fooled)
+vf_status vf__evaluate_batch(vf_attack_loss_fn loss_fn, void *ctx, const double *views, int n,
+                             double *losses, int *fooled)
 {
     memset(fooled, 0, (size_t)n * sizeof *fooled);
     vf_status status = loss_fn(views, n, losses, fooled, ctx);
@@ -224,7 +225,7 @@ vf_status evaluate_batch(vf_attack_loss_fn loss_fn, void *ctx, const double *vie
     return VF_OK;
 }
 
-vf_status history_push(vf_attack_state *st, const vf_attack_record *rec)
+vf_status vf__history_push(vf_attack_state *st, const vf_attack_record *rec)
 {
     if (st->step >= st->history_cap) {
         int cap = st->history_cap ? 2 * st->history_cap : 128;
@@ -238,7 +239,7 @@ vf_status history_push(vf_attack_state *st, const vf_attack_record *rec)
     return VF_OK;
 }
 
-void note_best(vf_attack_state *st, const double *views, const double *losses, int n)
+void vf__note_best(vf_attack_state *st, const double *views, const double *losses, int n)
 {
     int best = 0;
     for (int j = 1; j < n; j++)
@@ -252,7 +253,7 @@ void note_best(vf_attack_state *st, const double *views, const double *losses, i
     }
 }
 
-void batch_stats(const double *losses, const int *fooled, int n, vf_attack_record *rec)
+void vf__batch_stats(const double *losses, const int *fooled, int n, vf_attack_record *rec)
 {
     double sum = 0.0, top = -INFINITY;
     int n_fooled = 0;

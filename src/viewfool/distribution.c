@@ -101,7 +101,7 @@ static void quad_compute(void)
         quad_weights[q] /= sum;
 }
 
-void normal_quadrature(const double **nodes, const double **weights)
+void vf__normal_quadrature(const double **nodes, const double **weights)
 {
     pthread_once(&quad_once, quad_compute);
     *nodes = quad_nodes;
@@ -110,7 +110,7 @@ void normal_quadrature(const double **nodes, const double **weights)
 
 /* ---- entropy ---- */
 
-double log_sech2(double u)
+double vf__log_sech2(double u)
 {
     /* log(1 - tanh(u)^2) = -2 log cosh(u) = 2 (log 2 - |u| - log1p(exp(-2|u|))), stable for
      * any u (1 - tanh^2 underflows to 0 for |u| > 19 otherwise). */
@@ -121,12 +121,12 @@ double log_sech2(double u)
 double vf_log_jacobian_mean(double mu, double sigma, double *d_mu, double *d_sigma)
 {
     const double *x, *w;
-    normal_quadrature(&x, &w);
+    vf__normal_quadrature(&x, &w);
     double value = 0.0, gm = 0.0, gs = 0.0;
     for (int q = 0; q < QUAD_POINTS; q++) {
         double u = mu + sigma * x[q];
         double slope = -2.0 * tanh(u); /* d/du log(1 - tanh(u)^2) */
-        value += w[q] * log_sech2(u);
+        value += w[q] * vf__log_sech2(u);
         gm += w[q] * slope;
         gs += w[q] * slope * x[q];
     }

@@ -77,7 +77,7 @@ static double sum_log_sech2(const double u[VF_VIEW_DIM])
 {
     double s = 0.0;
     for (int i = 0; i < VF_VIEW_DIM; i++)
-        s += log_sech2(u[i]);
+        s += vf__log_sech2(u[i]);
     return s;
 }
 
@@ -95,7 +95,7 @@ static void add_score(const vf_attack_state *st, const double u[VF_VIEW_DIM],
 {
     double resp[VF_ATTACK_MAX_COMPONENTS] = {1.0}, pi[VF_ATTACK_MAX_COMPONENTS] = {1.0};
     if (st->components > 1) {
-        mixture_log_density(st, u, resp);
+        vf__mixture_log_density(st, u, resp);
         vf_attack_weights(st, pi);
     }
     for (int c = 0; c < st->components; c++) {
@@ -155,7 +155,7 @@ static void add_entropy_gradient(const vf_attack_state *st, const vf_attack_conf
     double h_sum = 0.0, g_h[VF_ATTACK_MAX_PARAMS];
     for (int j = 0; j < k; j++) {
         const double *uj = u + j * VF_VIEW_DIM;
-        h[j] = -mixture_log_density(st, uj, NULL) + sum_log_sech2(uj);
+        h[j] = -vf__mixture_log_density(st, uj, NULL) + sum_log_sech2(uj);
         h_sum += h[j];
     }
     *entropy = h_sum / k + sum_log_half_range(&cfg->bounds);
@@ -166,9 +166,9 @@ static void add_entropy_gradient(const vf_attack_state *st, const vf_attack_conf
         grad[p] += cfg->lambda * g_h[p];
 }
 
-vf_status nes_gradient(const vf_attack_state *st, const vf_attack_config *cfg,
-                       vf_attack_loss_fn loss_fn, void *ctx, vf_rng *rng, double *grad,
-                       double *views, double *losses, int *fooled, double *entropy)
+vf_status vf__nes_gradient(const vf_attack_state *st, const vf_attack_config *cfg,
+                           vf_attack_loss_fn loss_fn, void *ctx, vf_rng *rng, double *grad,
+                           double *views, double *losses, int *fooled, double *entropy)
 {
     int k = cfg->samples;
     int *comp = malloc((size_t)k * sizeof *comp);
@@ -181,7 +181,7 @@ vf_status nes_gradient(const vf_attack_state *st, const vf_attack_config *cfg,
         goto done;
     }
     nes_sample(st, cfg, rng, k, comp, eps, u, views);
-    if ((status = evaluate_batch(loss_fn, ctx, views, k, losses, fooled)) != VF_OK)
+    if ((status = vf__evaluate_batch(loss_fn, ctx, views, k, losses, fooled)) != VF_OK)
         goto done;
     score_gradient(st, u, eps, comp, losses, k, grad);
     natural_precondition(st, grad);
@@ -229,8 +229,8 @@ static void adam_update(vf_attack_state *st, const vf_attack_config *cfg, const 
     }
 }
 
-vf_status nes_step(vf_attack_state *st, const vf_attack_config *cfg, vf_attack_loss_fn loss_fn,
-                   void *ctx)
+vf_status vf__nes_step(vf_attack_state *st, const vf_attack_config *cfg, vf_attack_loss_fn loss_fn,
+                       void *ctx)
 {
     int k = cfg->samples;
     double grad[VF_ATTACK_MAX_PARAMS];
@@ -243,14 +243,14 @@ vf_status nes_step(vf_attack_state *st, const vf_attack_config *cfg, vf_attack_l
         status = vf_fail(VF_EINTERNAL, "out of memory for %d attack samples", k);
         goto done;
     }
-    status = nes_gradient(st, cfg, loss_fn, ctx, &st->rng, grad, views, losses, fooled,
-                          &rec.entropy);
+    status = vf__nes_gradient(st, cfg, loss_fn, ctx, &st->rng, grad, views, losses, fooled,
+                              &rec.entropy);
     if (status != VF_OK)
         goto done;
-    batch_stats(losses, fooled, k, &rec);
-    if ((status = history_push(st, &rec)) != VF_OK)
+    vf__batch_stats(losses, fooled, k, &rec);
+    if ((status = vf__history_push(st, &rec)) != VF_OK)
         goto done;
-    note_best(st, views, losses, k);
+    vf__note_best(st, views, losses, k);
     adam_update(st, cfg, grad);
     st->step++;
 done:

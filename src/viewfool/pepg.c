@@ -115,8 +115,8 @@ static void pepg_update(vf_attack_state *st, const vf_attack_config *cfg,
     }
 }
 
-vf_status pepg_step(vf_attack_state *st, const vf_attack_config *cfg, vf_attack_loss_fn loss_fn,
-                    void *ctx)
+vf_status vf__pepg_step(vf_attack_state *st, const vf_attack_config *cfg,
+                        vf_attack_loss_fn loss_fn, void *ctx)
 {
     int pairs = (cfg->samples - 1) / 2, k = 2 * pairs + 1;
     double *eps = malloc((size_t)pairs * VF_VIEW_DIM * sizeof *eps);
@@ -130,17 +130,17 @@ vf_status pepg_step(vf_attack_state *st, const vf_attack_config *cfg, vf_attack_
         goto done;
     }
     pepg_sample(st, cfg, pairs, eps, views);
-    if ((status = evaluate_batch(loss_fn, ctx, views, k, losses, fooled)) != VF_OK)
+    if ((status = vf__evaluate_batch(loss_fn, ctx, views, k, losses, fooled)) != VF_OK)
         goto done;
     if ((status = centred_ranks(losses, k, shaped)) != VF_OK)
         goto done;
 
     vf_attack_record rec;
-    batch_stats(losses, fooled, k, &rec);
+    vf__batch_stats(losses, fooled, k, &rec);
     rec.entropy = vf_squashed_entropy(&cfg->bounds, st->mu[0], st->sigma[0], NULL, NULL);
-    if ((status = history_push(st, &rec)) != VF_OK)
+    if ((status = vf__history_push(st, &rec)) != VF_OK)
         goto done;
-    note_best(st, views, losses, k);
+    vf__note_best(st, views, losses, k);
 
     double g_mu[VF_VIEW_DIM], g_sigma[VF_VIEW_DIM];
     pepg_gradient(st, cfg, pairs, eps, shaped, g_mu, g_sigma);

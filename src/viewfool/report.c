@@ -106,9 +106,9 @@ vf_status vf_attack_evaluate(vf_attack_loss_fn loss_fn, void *ctx, const double 
         status = vf_fail(VF_EINTERNAL, "out of memory evaluating %d viewpoints", n);
     } else {
         vf_attack_record rec;
-        status = evaluate_batch(loss_fn, ctx, views, n, losses ? losses : own, fooled);
+        status = vf__evaluate_batch(loss_fn, ctx, views, n, losses ? losses : own, fooled);
         if (status == VF_OK && asr) {
-            batch_stats(losses ? losses : own, fooled, n, &rec);
+            vf__batch_stats(losses ? losses : own, fooled, n, &rec);
             *asr = rec.fooled_rate;
         }
     }

@@ -144,7 +144,7 @@ static vf_status json_to_history(const json_t *obj, vf_attack_state *st)
         vf_status status = array_to_doubles(json_array_get(array, (size_t)t), "history", row, 4);
         vf_attack_record rec = {row[0], row[1], row[2], row[3]};
         if (status == VF_OK)
-            status = history_push(st, &rec);
+            status = vf__history_push(st, &rec);
         if (status != VF_OK)
             return status;
         st->step++;

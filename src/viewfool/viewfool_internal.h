@@ -34,35 +34,35 @@ static inline int param_sigma(int c, int i)
 static inline int param_logit(int c) { return c * VF_ATTACK_COMPONENT_PARAMS + 2 * VF_VIEW_DIM; }
 
 /* Nodes and weights (QUAD_POINTS of each) for E[f(eps)], eps ~ N(0, 1). */
-void normal_quadrature(const double **nodes, const double **weights);
+void vf__normal_quadrature(const double **nodes, const double **weights);
 
 /* log(1 - tanh(u)^2), stable for large |u|. */
-double log_sech2(double u);
+double vf__log_sech2(double u);
 
 /* log of the mixture density of u (in u space) and, when resp is not NULL, the K
  * responsibilities r_c(u) = w_c N_c(u) / p(u). */
-double mixture_log_density(const vf_attack_state *st, const double u[VF_VIEW_DIM],
-                           double *resp);
+double vf__mixture_log_density(const vf_attack_state *st, const double u[VF_VIEW_DIM],
+                               double *resp);
 
 /* Call loss_fn for n views, check every loss is finite. fooled gets zeroed first. */
-vf_status evaluate_batch(vf_attack_loss_fn loss_fn, void *ctx, const double *views, int n,
-                         double *losses, int *fooled);
+vf_status vf__evaluate_batch(vf_attack_loss_fn loss_fn, void *ctx, const double *views, int n,
+                             double *losses, int *fooled);
 
 /* Append a record to the history (grows it). VF_EINTERNAL when out of memory. */
-vf_status history_push(vf_attack_state *st, const vf_attack_record *rec);
+vf_status vf__history_push(vf_attack_state *st, const vf_attack_record *rec);
 
 /* Record the batch's best sample as the last step's best and, if better, the overall best. */
-void note_best(vf_attack_state *st, const double *views, const double *losses, int n);
+void vf__note_best(vf_attack_state *st, const double *views, const double *losses, int n);
 
 /* Fill a record's loss statistics from a batch. */
-void batch_stats(const double *losses, const int *fooled, int n, vf_attack_record *rec);
+void vf__batch_stats(const double *losses, const int *fooled, int n, vf_attack_record *rec);
 
-vf_status nes_step(vf_attack_state *st, const vf_attack_config *cfg, vf_attack_loss_fn loss_fn,
-                   void *ctx);
-vf_status nes_gradient(const vf_attack_state *st, const vf_attack_config *cfg,
-                       vf_attack_loss_fn loss_fn, void *ctx, vf_rng *rng, double *grad,
-                       double *views, double *losses, int *fooled, double *entropy);
-vf_status pepg_step(vf_attack_state *st, const vf_attack_config *cfg, vf_attack_loss_fn loss_fn,
-                    void *ctx);
+vf_status vf__nes_step(vf_attack_state *st, const vf_attack_config *cfg, vf_attack_loss_fn loss_fn,
+                       void *ctx);
+vf_status vf__nes_gradient(const vf_attack_state *st, const vf_attack_config *cfg,
+                           vf_attack_loss_fn loss_fn, void *ctx, vf_rng *rng, double *grad,
+                           double *views, double *losses, int *fooled, double *entropy);
+vf_status vf__pepg_step(vf_attack_state *st, const vf_attack_config *cfg,
+                        vf_attack_loss_fn loss_fn, void *ctx);
 
 #endif

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The library exports only its API (vf_*) and internal functions marked as such (vf__*): a bare
+# name such as `nes_step` or `plot_text` exported from libvf.a would collide with a user's own.
+source "$(dirname "$0")/shell_checks.sh"
+
+lib="$(dirname "$tool")/libvf.a"
+[ -f "$lib" ] && ok || bad "no $lib"
+bare=$(nm -g --defined-only "$lib" 2>/dev/null | awk '$2 ~ /^[TDBR]$/ {print $3}' |
+  grep -v -e '^vf_' -e '^_Z' | sort -u)
+[ -z "$bare" ] && ok || bad "libvf.a exports unprefixed symbols: $(echo $bare | head -c 400)"
+
+cli_finish
