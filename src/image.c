@@ -1,11 +1,14 @@
-/* The plain-C half of vf/image.h: memory, channel conversion and cropping. File I/O and
- * resizing are in oiio/image_oiio.cpp. */
+/* vf/image.h: memory, files (the pixels coded by oiio/image_oiio.cpp), EXIF orientation,
+ * channel conversion and cropping. */
 #include "vf/image.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "oiio/image_oiio.h"
+#include "vf/fsutil.h"
 
 vf_status vf_image_alloc(vf_image *img, int width, int height, int channels)
 {
@@ -28,6 +31,47 @@ void vf_image_free(vf_image *img)
         return;
     free(img->data);
     *img = (vf_image){0, 0, 0, NULL};
+}
+
+vf_status vf_image_info(const char *path, int *width, int *height, int *channels)
+{
+    int w, h, orientation;
+    vf_status status = vf__oiio_info(path, &w, &h, channels, &orientation);
+    if (status == VF_OK) {
+        *width = orientation >= 5 ? h : w;
+        *height = orientation >= 5 ? w : h;
+    }
+    return status;
+}
+
+vf_status vf_image_load(const char *path, vf_image *out)
+{
+    vf_image img;
+    int orientation;
+    vf_status status =
+        vf__oiio_read(path, &img.data, &img.width, &img.height, &img.channels, &orientation);
+    if (status != VF_OK || orientation == 1) {
+        if (status == VF_OK)
+            *out = img;
+        return status;
+    }
+    status = vf_image_reorient(&img, orientation, out);
+    vf_image_free(&img);
+    return status;
+}
+
+vf_status vf_image_save(const char *path, const vf_image *img)
+{
+    if (!img->data || img->width <= 0 || img->height <= 0 || img->channels <= 0)
+        return vf_fail(VF_EINPUT, "cannot write %s: the image is empty", path);
+    unsigned char *bytes = NULL;
+    size_t size = 0;
+    vf_status status =
+        vf__oiio_encode(path, img->data, img->width, img->height, img->channels, &bytes, &size);
+    if (status == VF_OK)
+        status = vf_write_file_atomic(path, bytes, size);
+    free(bytes);
+    return status;
 }
 
 vf_status vf_image_to_rgb(const vf_image *src, const float background[3], vf_image *out)

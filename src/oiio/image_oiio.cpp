@@ -1,6 +1,6 @@
-// The OpenImageIO side of vf/image.h: reading and writing image files.
-// A thin extern "C" layer: every OIIO failure becomes a vf_status with a one-line message.
-#include "vf/image.h"
+// The OpenImageIO side of vf/image.h: reading and writing image files as raw float pixels.
+// A thin extern "C" leaf: every OIIO failure becomes a vf_status with a one-line message.
+#include "image_oiio.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -8,11 +8,12 @@
 #include <cctype>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
 
-#include "vf/fsutil.h"
+#include "vf/fsutil.h" /* vf_is_file, vf_is_dir */
 
 using namespace OIIO;
 
@@ -110,9 +111,9 @@ const char *format_for(const char *path, TypeDesc *type)
     return nullptr;
 }
 
-// Encode img into memory in the given format.
-vf_status encode(const char *path, const char *format, TypeDesc type, const vf_image *img,
-                 std::vector<unsigned char> &bytes)
+// Encode the pixels into memory in the given format.
+vf_status encode(const char *path, const char *format, TypeDesc type, const float *pixels,
+                 int width, int height, int stored_channels, std::vector<unsigned char> &bytes)
 {
     Filesystem::IOVecOutput proxy(bytes);
     std::unique_ptr<ImageOutput> out = ImageOutput::create(format, &proxy);
@@ -120,17 +121,17 @@ vf_status encode(const char *path, const char *format, TypeDesc type, const vf_i
         return vf_fail(VF_EINTERNAL, "cannot write %s: no %s writer (%s)", path, format,
                        first_line(OIIO::geterror()).c_str());
     // JPEG holds no alpha: write only the colour channels (grey or RGB).
-    int channels = img->channels;
+    int channels = stored_channels;
     if (std::strcmp(format, "jpeg") == 0 && (channels == 2 || channels >= 4))
         channels = channels == 2 ? 1 : 3;
-    ImageSpec spec(img->width, img->height, channels, type);
+    ImageSpec spec(width, height, channels, type);
     if (std::strcmp(format, "png") == 0) // else OIIO un-premultiplies our straight alpha
         spec.attribute("oiio:UnassociatedAlpha", 1);
     if (std::strcmp(format, "jpeg") == 0)
         spec.attribute("CompressionQuality", 95);
-    stride_t xstride = (stride_t)(img->channels * sizeof(float));
+    stride_t xstride = (stride_t)(stored_channels * sizeof(float));
     bool ok = out->open("memory", spec) &&
-              out->write_image(TypeDesc::FLOAT, img->data, xstride) && out->close();
+              out->write_image(TypeDesc::FLOAT, pixels, xstride) && out->close();
     if (!ok)
         return vf_fail(VF_EINTERNAL, "cannot write %s: %s", path,
                        first_line(out->geterror()).c_str());
@@ -148,64 +149,69 @@ int orientation_of(ImageInput &in)
 
 } // namespace
 
-extern "C" vf_status vf_image_info(const char *path, int *width, int *height, int *channels)
+extern "C" vf_status vf__oiio_info(const char *path, int *width, int *height, int *channels,
+                                   int *orientation)
 {
     std::unique_ptr<ImageInput> in;
     vf_status status = open_input(path, in);
     if (status != VF_OK)
         return status;
-    bool swap = orientation_of(*in) >= 5;
-    *width = swap ? in->spec().height : in->spec().width;
-    *height = swap ? in->spec().width : in->spec().height;
+    *width = in->spec().width;
+    *height = in->spec().height;
     *channels = in->spec().nchannels;
+    *orientation = orientation_of(*in);
     return VF_OK;
 }
 
-extern "C" vf_status vf_image_load(const char *path, vf_image *out)
+extern "C" vf_status vf__oiio_read(const char *path, float **pixels, int *width, int *height,
+                                   int *channels, int *orientation)
 {
     std::unique_ptr<ImageInput> in;
     vf_status status = open_input(path, in);
     if (status != VF_OK)
         return status;
     const ImageSpec &spec = in->spec();
-    vf_image img;
-    status = vf_image_alloc(&img, spec.width, spec.height, spec.nchannels);
-    if (status != VF_OK)
-        return status;
+    size_t count = (size_t)spec.width * (size_t)spec.height * (size_t)spec.nchannels;
+    if (count > SIZE_MAX / sizeof(float) / 2 || (size_t)spec.width > SIZE_MAX / spec.height)
+        return vf_fail(VF_EINPUT, "cannot read %s: %dx%d is too large", path, spec.width,
+                       spec.height);
+    float *data = (float *)std::malloc(count * sizeof(float));
+    if (!data)
+        return vf_fail(VF_EINTERNAL, "out of memory for a %dx%d image", spec.width, spec.height);
     // A truncated JPEG "succeeds" (grey fill) but leaves an error behind: treat it as failed.
-    if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, img.data) || in->has_error()) {
-        vf_image_free(&img);
+    if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, data) || in->has_error()) {
+        std::free(data);
         return vf_fail(VF_EINPUT, "cannot read %s: %s", path, first_line(in->geterror()).c_str());
     }
-    int orientation = orientation_of(*in);
-    if (orientation != 1) {
-        vf_image shown;
-        status = vf_image_reorient(&img, orientation, &shown);
-        vf_image_free(&img);
-        if (status != VF_OK)
-            return status;
-        img = shown;
-    }
-    *out = img;
+    *pixels = data;
+    *width = spec.width;
+    *height = spec.height;
+    *channels = spec.nchannels;
+    *orientation = orientation_of(*in);
     return VF_OK;
 }
 
-extern "C" vf_status vf_image_save(const char *path, const vf_image *img)
+extern "C" vf_status vf__oiio_encode(const char *path, const float *pixels, int width,
+                                     int height, int channels, unsigned char **bytes,
+                                     size_t *size)
 {
     TypeDesc type;
     const char *format = format_for(path, &type);
     if (!format)
         return vf_fail(VF_EINPUT, "cannot write %s: unknown extension (use .png, .jpg or .exr)",
                        path);
-    if (!img->data || img->width <= 0 || img->height <= 0 || img->channels <= 0)
-        return vf_fail(VF_EINPUT, "cannot write %s: the image is empty", path);
-    std::vector<unsigned char> bytes;
+    std::vector<unsigned char> encoded;
     try {
-        vf_status status = encode(path, format, type, img, bytes);
+        vf_status status = encode(path, format, type, pixels, width, height, channels, encoded);
         if (status != VF_OK)
             return status;
     } catch (const std::exception &e) {
         return vf_fail(VF_EINTERNAL, "cannot write %s: %s", path, e.what());
     }
-    return vf_write_file_atomic(path, bytes.data(), bytes.size());
+    *bytes = (unsigned char *)std::malloc(encoded.size() ? encoded.size() : 1);
+    if (!*bytes)
+        return vf_fail(VF_EINTERNAL, "out of memory encoding %s", path);
+    std::memcpy(*bytes, encoded.data(), encoded.size());
+    *size = encoded.size();
+    return VF_OK;
 }
