@@ -47,8 +47,10 @@ void vf_object3d_capture_poses(const vf_object3d_capture *c, double *c2w)
     for (int i = 0; i < c->views + c->test_views; i++) {
         /* uniform over the sphere's area: the height is uniform */
         double z = z0 + (1 - z0) * vf_rng_uniform(&rng);
+        /* phi = 180 - elevation: the same position with phi = elevation would roll the camera
+         * 180 degrees (vf/pose.h), and upside-down photos are not the paper's capture. */
         vf_viewpoint v = {.psi = 360 * vf_rng_uniform(&rng) - 180,
-                          .phi = asin(z) * 180 / M_PI,
+                          .phi = 180 - asin(z) * 180 / M_PI,
                           .dy = c->distance - VF_CAMERA_DISTANCE};
         vf_viewpoint_to_c2w(&v, c2w + 16 * i);
     }
