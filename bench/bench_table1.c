@@ -148,12 +148,18 @@ static void method_row(const options *o, const object_spec *obj, const char *ws,
     json_decref(doc);
 }
 
+/* ingest_s and train_s are NAN on the mean rows (they are per object, not per method): "-". */
 static void print_row(const char *object, const char *method, const row *r, double ingest_s,
                       double train_s)
 {
-    printf("%-14s %-7s %6.0f %6.0f   %6.0f %6.0f   %6.0f %6.0f   %6.0f %6.0f %6.0f %6.0f\n",
+    char ingest[16] = "-", train[16] = "-";
+    if (!isnan(ingest_s))
+        snprintf(ingest, sizeof ingest, "%.0f", ingest_s);
+    if (!isnan(train_s))
+        snprintf(train, sizeof train, "%.0f", train_s);
+    printf("%-14s %-7s %6.0f %6.0f   %6.0f %6.0f   %6.0f %6.0f   %6s %6s %6.0f %6.0f\n",
            object, method, 100 * r->nat_field, 100 * r->nat_real, 100 * r->asr_samples,
-           100 * r->asr_vstar, 100 * r->real_samples, 100 * r->real_vstar, ingest_s, train_s,
+           100 * r->asr_vstar, 100 * r->real_samples, 100 * r->real_vstar, ingest, train,
            r->attack_s, r->real_s);
 }
 
