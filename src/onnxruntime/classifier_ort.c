@@ -58,12 +58,18 @@ static vf_status find_package(char *out, size_t size)
     return VF_OK;
 }
 
+/* node and the package folder (both VF_PATH_MAX buffers), or what is missing. */
+static vf_status find_runtime(char *node, char *package)
+{
+    vf_status status =
+        vf_find_program("VF_NODE", "node", "apt-get install nodejs npm", node, VF_PATH_MAX);
+    return status == VF_OK ? find_package(package, VF_PATH_MAX) : status;
+}
+
 vf_status vf_ort_available(void)
 {
     char node[VF_PATH_MAX], package[VF_PATH_MAX];
-    vf_status status = vf_find_program("VF_NODE", "node", "apt-get install nodejs npm", node,
-                                       sizeof node);
-    return status == VF_OK ? find_package(package, sizeof package) : status;
+    return find_runtime(node, package);
 }
 
 /* The last non-empty line the worker printed (a crash's reason), or "". */
@@ -178,10 +184,7 @@ static vf_status take_hello(vf_ort *ort, json_t *hello)
 vf_status vf_ort_load(const char *path, vf_ort **out)
 {
     char node[VF_PATH_MAX], package[VF_PATH_MAX];
-    vf_status status = vf_find_program("VF_NODE", "node", "apt-get install nodejs npm", node,
-                                       sizeof node);
-    if (status == VF_OK)
-        status = find_package(package, sizeof package);
+    vf_status status = find_runtime(node, package);
     if (status != VF_OK)
         return status;
     vf_ort *ort = calloc(1, sizeof *ort);
