@@ -45,7 +45,8 @@
 
 typedef struct scene {
     const char *name, *transforms, *labels;
-    int real; /* real photos: normalize, keep the background, limit the box to the photos */
+    int real; /* real photos: normalize, limit the box to the photos (their surroundings are
+                 modelled by default) */
 } scene;
 
 static const scene scenes[] = {
@@ -87,7 +88,6 @@ static vf_field *train_field(const scene *sc, const vf_dataset *ds, const double
     vf_field_train_options opt;
     vf_field_train_defaults(&opt);
     opt.seconds = seconds;
-    opt.keep_background = sc->real;
     vf_field_trainer *t;
     if (vf_field_trainer_create(&opt, &t) != VF_OK)
         die("trainer");

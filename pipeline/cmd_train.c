@@ -3,7 +3,8 @@
  * Views come from WS/poses/transforms_undistorted.json (a capture) or WS/ingest/transforms.json
  * (an imported posed set). Every Nth view is held out and scored (PSNR, SSIM) after training.
  * The trainer checkpoints into the stage's staging folder, so an interrupted run continues from
- * there; WS/train/ gets model.vff and report.json. */
+ * there; WS/train/ gets model.vff, report.json and held_out.jpg (held-out photos beside their
+ * renders). */
 #define _GNU_SOURCE
 #include <math.h>
 #include <stdlib.h>
@@ -14,36 +15,40 @@
 #include "vf/field.h"
 #include "vf/log.h"
 #include "vf/metrics.h"
+#include "vf/plot.h"
 #include "vf/workspace.h"
 
 #define CHECKPOINT_SECONDS 30.0
 #define CHECKPOINT_FILE "checkpoint.vfc"
 
 static const char usage[] =
-    "usage: vfcapture train WS [--minutes M | --steps N] [--holdout N] [--keep-background]\n"
+    "usage: vfcapture train WS [--minutes M | --steps N] [--holdout N] [--surroundings MODE]\n"
     "                      [--restart]\n"
     "\n"
     "Fit a radiance field (an explicit density + spherical-harmonics grid, coarse to fine) to\n"
     "the posed images of WS: the undistorted frames of the poses stage, or an imported posed\n"
     "set. Every Nth view is held out and its PSNR reported. An interrupted run continues from\n"
-    "its last checkpoint. Writes WS/train/model.vff and WS/train/report.json.\n"
+    "its last checkpoint. Writes WS/train/model.vff, report.json and held_out.jpg (held-out\n"
+    "photos beside their renders).\n"
     "\n"
     "options:\n"
     "      --minutes M        training wall time (default 3)\n"
     "      --steps N          train for N optimizer steps instead of a time (the same field\n"
     "                         however busy the machine is)\n"
     "      --holdout N        hold out every Nth view for scoring, 0 for none (default 10)\n"
-    "      --keep-background  opaque photos: also model the surroundings beyond the object\n"
-    "                         (default: only the region the cameras look at)\n"
+    "      --surroundings MODE  what lies beyond the box the cameras look at: auto (a coarser\n"
+    "                         outer grid for opaque photos, none for background-removed ones;\n"
+    "                         the default), grid, or none (the box must explain everything)\n"
     "      --restart          ignore a checkpoint of an interrupted run\n" CLI_COMMON_HELP;
 
-enum { OPT_MINUTES = CLI_OPT_FIRST_CUSTOM, OPT_STEPS, OPT_HOLDOUT, OPT_KEEP_BACKGROUND, OPT_RESTART };
+enum { OPT_MINUTES = CLI_OPT_FIRST_CUSTOM, OPT_STEPS, OPT_HOLDOUT, OPT_SURROUNDINGS, OPT_RESTART };
 
 typedef struct train_options {
     const char *workspace;
     double minutes;
     int steps; /* > 0: a step budget instead of minutes */
-    int holdout, keep_background, restart;
+    int holdout, restart;
+    vf_field_surroundings surroundings;
     cli_flags flags;
 } train_options;
 
@@ -54,7 +59,7 @@ static vf_status parse_options(int argc, char **argv, train_options *opt)
         {"minutes", required_argument, NULL, OPT_MINUTES},
         {"steps", required_argument, NULL, OPT_STEPS},
         {"holdout", required_argument, NULL, OPT_HOLDOUT},
-        {"keep-background", no_argument, NULL, OPT_KEEP_BACKGROUND},
+        {"surroundings", required_argument, NULL, OPT_SURROUNDINGS},
         {"restart", no_argument, NULL, OPT_RESTART},
         {0, 0, 0, 0},
     };
@@ -78,8 +83,12 @@ static vf_status parse_options(int argc, char **argv, train_options *opt)
                 return vf_fail(VF_EINPUT, "--holdout must be 0 or a whole number from 2 up, not "
                                           "'%s'", optarg);
             opt->holdout = (int)value;
-        } else if (c == OPT_KEEP_BACKGROUND) {
-            opt->keep_background = 1;
+        } else if (c == OPT_SURROUNDINGS) {
+            int mode = vf_field_surroundings_parse(optarg);
+            if (mode < 0)
+                return vf_fail(VF_EINPUT, "--surroundings must be auto, grid or none, not '%s'",
+                               optarg);
+            opt->surroundings = (vf_field_surroundings)mode;
         } else if (c == OPT_RESTART) {
             opt->restart = 1;
         }
@@ -155,15 +164,29 @@ static vf_status run_training(vf_field_trainer *t, const char *checkpoint,
     return status;
 }
 
-/* PSNR and SSIM of the held-out views; adds a per-view list to report. */
+#define SHEET_PAIRS 6    /* held-out photos shown beside their renders */
+#define SHEET_HEIGHT 240 /* pixels of a tile */
+
+/* A copy of img SHEET_HEIGHT pixels high, for the contact sheet. */
+static vf_status sheet_tile(const vf_image *img, vf_image *out)
+{
+    int w = (int)lround((double)img->width * SHEET_HEIGHT / img->height);
+    return vf_image_resize(img, w > 0 ? w : 1, SHEET_HEIGHT, out);
+}
+
+/* PSNR and SSIM of the held-out views; adds a per-view list to report, and writes sheet_path:
+ * the first few held-out photos beside their renders. */
 static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int holdout,
-                                json_t *report, double *mean_psnr, double *mean_ssim)
+                                const char *sheet_path, json_t *report, double *mean_psnr,
+                                double *mean_ssim)
 {
     float bg[3];
     vf_field_background(f, bg);
     json_t *list = json_array();
     double psnr_sum = 0, ssim_sum = 0;
-    int n = 0;
+    int n = 0, tiles = 0;
+    vf_image sheet[2 * SHEET_PAIRS] = {{0}};
+    char captions[2 * SHEET_PAIRS][96];
     vf_status status = VF_OK;
     for (int i = 0; i < views->count && status == VF_OK; i++) {
         if (!is_held_out(i, holdout))
@@ -181,10 +204,25 @@ static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int 
             vf_path_basename(name, sizeof name, views->frames[i].image_path, 0);
             json_array_append_new(list, json_pack("{s:s, s:f, s:f}", "image", name, "psnr", psnr,
                                                   "ssim", ssim));
+            if (tiles < 2 * SHEET_PAIRS) {
+                snprintf(captions[tiles], sizeof captions[tiles], "photo %.80s", name);
+                status = sheet_tile(&photo, &sheet[tiles++]);
+                snprintf(captions[tiles], sizeof captions[tiles], "render\n%.1f dB", psnr);
+                if (status == VF_OK)
+                    status = sheet_tile(&render, &sheet[tiles++]);
+            }
         }
         vf_image_free(&photo);
         vf_image_free(&render);
     }
+    if (status == VF_OK && tiles > 0) {
+        const char *caption_list[2 * SHEET_PAIRS];
+        for (int i = 0; i < tiles; i++)
+            caption_list[i] = captions[i];
+        status = vf_contact_sheet(sheet_path, sheet, caption_list, NULL, tiles, 4);
+    }
+    for (int i = 0; i < tiles; i++)
+        vf_image_free(&sheet[i]);
     *mean_psnr = n ? psnr_sum / n : NAN;
     *mean_ssim = n ? ssim_sum / n : NAN;
     json_object_set_new(report, "held_out", list);
@@ -211,7 +249,7 @@ static vf_status train(const train_options *opt, vf_workspace *ws)
     topt.seconds = opt->steps ? 0 : 60 * opt->minutes;
     if (opt->steps)
         topt.steps = opt->steps;
-    topt.keep_background = opt->keep_background;
+    topt.surroundings = opt->surroundings;
     vf_field_trainer *t = NULL;
     vf_stage stage;
     char checkpoint[VF_PATH_MAX], model[VF_PATH_MAX], report_path[VF_PATH_MAX];
@@ -247,8 +285,11 @@ static vf_status train(const train_options *opt, vf_workspace *ws)
     json_t *report = json_object();
     double psnr = NAN, ssim = NAN;
     const vf_field *field = t ? vf_field_trainer_field(t) : NULL;
+    char sheet[VF_PATH_MAX];
     if (status == VF_OK)
-        status = score_held_out(field, &views, opt->holdout, report, &psnr, &ssim);
+        status = vf_path_join(sheet, sizeof sheet, stage.dir, "held_out.jpg");
+    if (status == VF_OK)
+        status = score_held_out(field, &views, opt->holdout, sheet, report, &psnr, &ssim);
     if (status == VF_OK)
         status = vf_path_join(model, sizeof model, stage.dir, "model.vff");
     if (status == VF_OK)
@@ -256,12 +297,18 @@ static vf_status train(const train_options *opt, vf_workspace *ws)
     if (status == VF_OK) {
         vf_field_info info;
         vf_field_get_info(field, &info);
-        json_object_update_new(report, json_pack("{s:i, s:i, s:i, s:f, s:i, s:[i,i,i], s:I}",
-                                                 "views", views.count - held, "held_out_views",
-                                                 held, "steps", st.step, "seconds", st.elapsed,
-                                                 "background_kept", opt->keep_background, "grid",
-                                                 info.dim[0], info.dim[1], info.dim[2], "bytes",
-                                                 (json_int_t)info.bytes));
+        /* what was modelled, which "auto" decides from the photos */
+        const char *kind = info.has_background_grid ? "object box + outer grid"
+                           : with_alpha             ? "object box (background-removed photos)"
+                                                    : "object box only";
+        json_object_update_new(report,
+                               json_pack("{s:i, s:i, s:i, s:f, s:s, s:s, s:[i,i,i], s:I}", "views",
+                                         views.count - held, "held_out_views", held, "steps",
+                                         st.step, "seconds", st.elapsed, "surroundings",
+                                         info.has_background_grid ? "grid" : "none", "field", kind,
+                                         "grid", info.dim[0], info.dim[1], info.dim[2], "bytes",
+                                         (json_int_t)info.bytes));
+        vf_info("field: %s", kind);
         if (held)
             json_object_update_new(report, json_pack("{s:f, s:f}", "held_out_psnr", psnr,
                                                      "held_out_ssim", ssim));
@@ -280,9 +327,9 @@ static vf_status train(const train_options *opt, vf_workspace *ws)
                                        ssim, "steps", st.step)
                            : json_pack("{s:i}", "steps", st.step);
     status = vf_stage_commit(&stage,
-                             json_pack("{s:f, s:i, s:i, s:b}", "minutes", opt->minutes, "steps",
-                                       opt->steps, "holdout", opt->holdout, "keep_background",
-                                       opt->keep_background),
+                             json_pack("{s:f, s:i, s:i, s:s}", "minutes", opt->minutes, "steps",
+                                       opt->steps, "holdout", opt->holdout, "surroundings",
+                                       vf_field_surroundings_name(opt->surroundings)),
                              json_incref(summary));
     /* The checkpoint goes only once the stage is in place: after a failed commit the next run
      * resumes from it at its end instead of training again. */

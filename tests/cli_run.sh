@@ -12,11 +12,13 @@ budget=(--train-steps 500 --steps 2 --samples 6 --label "folding chair,rocking c
 
 expect 0 "run on the chair" -- "$tool" run "$chair/transforms_train.json" -o "$ws" "${budget[@]}" --json
 json_check "run reports the attack" 'd["attack"]["asr_v_star"] >= 0 and d["shot_card"].endswith("shot_card.png")'
-for f in train/model.vff train/report.json attack/attack.json attack/v_star.png export/targets.json export/shot_card.png; do
+for f in train/model.vff train/report.json train/held_out.jpg attack/attack.json attack/v_star.png export/targets.json export/shot_card.png; do
   [ -s "$ws/$f" ] && ok || bad "run wrote $f"
 done
 python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["held_out_psnr"] > 22, r["held_out_psnr"]' "$ws/train/report.json" \
   && ok || bad "held-out PSNR after 500 steps is above 22 dB (a white image scores 14.4 dB): $(cat "$ws/train/report.json" | head -c 300)"
+python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["surroundings"] == "none" and "background-removed" in r["field"], r' "$ws/train/report.json" \
+  && ok || bad "auto: no outer grid for the chair's transparent background, and the report says so"
 
 expect 0 "run again" -- "$tool" run "$chair/transforms_train.json" -o "$ws" "${budget[@]}"
 [ "$(grep -c "is up to date" "$tmp/err")" -eq 4 ] && ok || bad "every stage up to date on the second run: $(cat "$tmp/err")"
@@ -53,6 +55,8 @@ expect 1 "train: no workspace" -- "$tool" train "$tmp/nowhere"
 one_line_naming "train: no workspace" "nowhere"
 expect 1 "train: bad --minutes" -- "$tool" train "$ws" --minutes -1
 one_line_naming "train: bad --minutes" "--minutes"
+expect 1 "train: unknown surroundings" -- "$tool" train "$ws" --surroundings room
+one_line_naming "train: unknown surroundings" "--surroundings"
 expect 1 "render: malformed viewpoint" -- "$tool" render "$ws" --viewpoint 1,2,3 -o "$tmp/x.png"
 one_line_naming "render: malformed viewpoint" "--viewpoint"
 expect 1 "eval: missing test set" -- "$tool" eval "$ws" --transforms "$tmp/none.json"

@@ -89,17 +89,18 @@ static void test_alpha_table(void)
     vf_field_free(f);
 }
 
-/* loss = g . rgb(ray) for a fixed g; its gradient by vf__field_backward and by central
- * differences. */
+/* loss = g . rgb(ray) for a fixed g, plus `opaque` times the transmittance left; its gradient
+ * by vf__field_backward and by central differences. */
 static double ray_loss(const vf_field *f, const field_ray *ray, field_scratch *sc,
-                       const float g[3])
+                       const float g[3], float opaque)
 {
     field_march_result res;
     vf__field_march(f, ray, 0.3f, 0.0f, sc, &res);
-    return (double)g[0] * res.rgb[0] + (double)g[1] * res.rgb[1] + (double)g[2] * res.rgb[2];
+    return (double)g[0] * res.rgb[0] + (double)g[1] * res.rgb[1] + (double)g[2] * res.rgb[2] +
+           (double)opaque * res.trans;
 }
 
-static void test_gradients(void)
+static void test_gradients(float opaque)
 {
     vf_field *f = make_field();
     field_grid *grid = &f->grids[0];
@@ -121,7 +122,7 @@ static void test_gradients(void)
     CHECK(res.count > 10, "the test ray takes %d samples", res.count);
     CHECK(res.trans > 0.01f && res.trans < 0.99f, "the test ray is partly opaque (T = %g)",
           res.trans);
-    vf__field_backward(f, &ray, &sc, &res, g, &sink);
+    vf__field_backward(f, &ray, &sc, &res, g, opaque, &sink);
     CHECK(sink.count[0] > 8, "the ray touched %zu points", sink.count[0]);
 
     int checked = 0, bad = 0;
@@ -132,9 +133,9 @@ static void test_gradients(void)
             float *value = &grid->values[i * FIELD_CH + ch];
             const float saved = *value, h = 1e-2f;
             *value = saved + h;
-            double up = ray_loss(f, &ray, &sc, g);
+            double up = ray_loss(f, &ray, &sc, g, opaque);
             *value = saved - h;
-            double down = ray_loss(f, &ray, &sc, g);
+            double down = ray_loss(f, &ray, &sc, g, opaque);
             *value = saved;
             double numeric = (up - down) / (2 * h), analytic = sink.grad[0][i * FIELD_CH + ch];
             double err = fabs(numeric - analytic) / fmax(1e-3, fabs(numeric) + fabs(analytic));
@@ -144,8 +145,10 @@ static void test_gradients(void)
         }
     }
     CHECK(checked > 20, "checked %d gradients", checked);
-    CHECK(bad == 0, "%d of %d gradients differ from finite differences (worst relative %g)", bad,
-          checked, worst);
+    CHECK(bad == 0,
+          "opaque %g: %d of %d gradients differ from finite differences (worst "
+          "relative %g)",
+          opaque, bad, checked, worst);
     free(sink.grad[0]);
     free(sink.touched[0]);
     free(sink.list[0]);
@@ -593,7 +596,8 @@ int main(void)
     test_fast_math();
     test_alpha_table();
     test_empty_radius();
-    test_gradients();
+    test_gradients(0);
+    test_gradients(0.7f);
     test_render_matches_march();
     test_jumps_skip_only_empty();
     test_model_files();

@@ -105,6 +105,17 @@ void vf_field_free(vf_field *f);
 
 /* ---- training ---------------------------------------------------------------------------- */
 
+/* What the field models beyond the object box the cameras look at. */
+typedef enum vf_field_surroundings {
+    VF_SURROUNDINGS_AUTO = 0, /* opaque photos: a grid; photos with alpha: none (the default) */
+    VF_SURROUNDINGS_GRID,     /* a coarser outer grid for the room, the desk, the wall */
+    VF_SURROUNDINGS_NONE      /* nothing: the object box must explain every pixel */
+} vf_field_surroundings;
+
+/* "auto", "grid", "none"; vf_field_surroundings_parse returns -1 for any other name. */
+const char *vf_field_surroundings_name(vf_field_surroundings s);
+int vf_field_surroundings_parse(const char *name);
+
 typedef struct vf_field_train_options {
     double seconds;          /* training time budget in wall-clock seconds (0: use steps) */
     int steps;               /* number of optimizer steps when seconds is 0 */
@@ -113,12 +124,21 @@ typedef struct vf_field_train_options {
     int levels;              /* coarse-to-fine levels (each 2x the points of the one before) */
     double upsample_end;     /* fraction of the budget by which the finest level is reached */
     float background[3];     /* colour behind transparent pixels, and of rays that see nothing */
-    int keep_background;     /* opaque photos: also fit the surroundings (coarse outer grid) */
-    float background_scale;  /* the outer grid's box is this many times the object box */
-    float box_scale;         /* object box half-size, as a fraction of the camera distance
-                                times tan(half the narrower field of view) (0: automatic) */
+    vf_field_surroundings surroundings; /* opaque photos only: photos with alpha never get an
+                                           outer grid (there is nothing around the object) */
+    float background_scale;     /* the outer grid's half-size, in units of the camera distance
+                                   times tan(half the narrower field of view) (at least 1.5 times
+                                   the object box's) */
+    float box_scale;            /* object box half-size in the same units (0: automatic: 1.2 for
+                                   photos with alpha, before the visual hull shrinks it; 0.6 for
+                                   opaque photos with an outer grid; 1 without) */
+    float step_ratio;           /* sample spacing along a ray, in voxels of the grid marched
+                                   (0: automatic: 0.5, or 1 for opaque photos with an outer grid) */
     float lr_density, lr_color; /* Adam learning rates (decay 10x over the run) */
     float tv_density, tv_color; /* total-variation weights (0: off) */
+    float opaque;               /* opaque photos: weight of a loss on the transmittance a ray
+                                   leaves for the background colour (every pixel sees a surface;
+                                   without it a room trains into haze over the background) */
     float prune_alpha;       /* by 70% of the budget (and 1200 steps at the earliest), cells
                                 where no corner reaches this opacity per step are pruned (0: no
                                 pruning ramp; see train.c) */
@@ -126,7 +146,8 @@ typedef struct vf_field_train_options {
     int threads;             /* 0: all cores */
 } vf_field_train_options;
 
-/* Fill in the defaults (3 minutes, 8192 rays a step, 128^3 points, white background...). */
+/* Fill in the defaults (3 minutes, 8192 rays a step, 128^3 points, white background,
+ * surroundings modelled for opaque photos...). */
 void vf_field_train_defaults(vf_field_train_options *opt);
 
 typedef struct vf_field_trainer vf_field_trainer;

@@ -231,8 +231,16 @@ vf_status vf__trainer_build_grid(vf_field_trainer *t)
     vf__trainer_scene_center(t, center, &distance);
     const vf_camera *cam = &t->views[0].camera;
     double tan_half = fmin(0.5 * cam->width / cam->fx, 0.5 * cam->height / cam->fy);
-    double box_scale = t->opt.box_scale > 0 ? t->opt.box_scale : t->has_alpha ? 1.2 : 1.0;
-    double half = box_scale * distance * tan_half;
+    /* Opaque photos with an outer grid: a box over 60% of the view, whose finer voxels go to
+     * the object while the outer grid takes the room. The fox at 3 minutes: 23.05 dB held-out
+     * against 20.85 dB with the box over the whole view (0.45: 20.43 dB). */
+    const vf_field_surroundings around = t->opt.surroundings;
+    const int outer = !t->has_alpha && around != VF_SURROUNDINGS_NONE;
+    double box_scale = t->opt.box_scale > 0 ? t->opt.box_scale
+                       : t->has_alpha       ? 1.2
+                       : outer              ? 0.6
+                                            : 1.0;
+    double view_half = distance * tan_half, half = box_scale * view_half;
     double lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
         lo[a] = center[a] - half;
@@ -248,7 +256,9 @@ vf_status vf__trainer_build_grid(vf_field_trainer *t)
     memcpy(f->scene_center, center, sizeof f->scene_center);
     f->camera_distance = distance;
     memcpy(f->background, t->opt.background, sizeof f->background);
-    f->step_ratio = 0.5f;
+    /* a sample a voxel, not two, in an opaque capture: half the samples for the same fit (the
+     * fox at 3 minutes: 23.44 and 22.97 dB held-out, against 23.05, 23.10 and 23.13 dB) */
+    f->step_ratio = t->opt.step_ratio > 0 ? t->opt.step_ratio : outer ? 1.0f : 0.5f;
     f->occupancy_alpha = (float)TRAIN_OCCUPANCY_ALPHA;
     /* renders end a ray once 99% of it is covered: chair test PSNR unchanged (34.11 -> 34.12
      * dB against 1e-3), a 224x224 render about a tenth faster */
@@ -281,9 +291,10 @@ vf_status vf__trainer_build_grid(vf_field_trainer *t)
     if (t->has_alpha && (status = carve_grid(t, &f->grids[0], near_depth)) != VF_OK)
         return status;
 
-    if (t->opt.keep_background && !t->has_alpha) {
-        /* a coarse outer grid for what lies around the object box */
-        double outer_half = half * fmax(t->opt.background_scale, 1.5), olo[3], ohi[3];
+    if (outer) {
+        /* a coarse outer grid for what lies around the object box: without it an opaque
+         * capture's room is fitted inside the box, as haze (the fox: 21.4 dB held-out) */
+        double outer_half = fmax(t->opt.background_scale * view_half, 1.5 * half), olo[3], ohi[3];
         for (int a = 0; a < 3; a++) {
             olo[a] = center[a] - outer_half;
             ohi[a] = center[a] + outer_half;

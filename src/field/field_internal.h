@@ -206,10 +206,12 @@ typedef struct field_grad_sink {
     size_t count[FIELD_MAX_GRIDS];
 } field_grad_sink;
 
-/* Accumulate dL/dvalues for one marched ray, given dL/drgb of its composited colour, into
- * the sink. `res` is the forward result of the same ray. */
+/* Accumulate dL/dvalues for one marched ray into the sink: L is the colour loss, given by
+ * dL/drgb of the composited colour, plus `opaque` times the transmittance left for the
+ * background (0 for rays that may see nothing). `res` is the forward result of the same ray. */
 void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
-                    const field_march_result *res, const float dl_drgb[3], field_grad_sink *sink);
+                        const field_march_result *res, const float dl_drgb[3], float opaque,
+                        field_grad_sink *sink);
 
 /* Clip a ray to a box; returns 0 when it misses. */
 int vf__field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], float *t0,

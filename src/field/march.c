@@ -222,14 +222,17 @@ static inline void scatter(const vf_field *f, field_grad_sink *sink, const field
 }
 
 void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
-                        const field_march_result *res, const float dl_drgb[3],
+                        const field_march_result *res, const float dl_drgb[3], float opaque,
                         field_grad_sink *sink)
 {
     const float basis[4] = {1.0f, ray->dir[0], ray->dir[1], ray->dir[2]};
     const float *g = dl_drgb;
     /* With C the full colour and P_i the colour composited up to and including sample i,
-     * dC/dtau_i = T_{i+1} c_i - (C - P_i) where tau_i = sigma_i * step (alpha = 1 - e^-tau). */
-    const float g_total = g[0] * res->rgb[0] + g[1] * res->rgb[1] + g[2] * res->rgb[2];
+     * dC/dtau_i = T_{i+1} c_i - (C - P_i) where tau_i = sigma_i * step (alpha = 1 - e^-tau).
+     * The loss `opaque` T_end (T_end the transmittance left for the background, whose
+     * derivative is -T_end) enters C - P_i like the background's colour term T_end bg. */
+    const float g_total =
+        g[0] * res->rgb[0] + g[1] * res->rgb[1] + g[2] * res->rgb[2] + opaque * res->trans;
     float g_prefix = 0;
     for (int i = 0; i < res->count; i++) {
         const field_sample *r = &rec->samples[i];

@@ -25,7 +25,7 @@
 #define MODEL_MAGIC "VFFIELD\n"
 #define MODEL_VERSION 1u
 #define CHECKPOINT_MAGIC "VFCKPT\n"
-#define CHECKPOINT_VERSION 1u
+#define CHECKPOINT_VERSION 2u /* 2: surroundings model replaced keep_background */
 
 /* ---- a file with a running checksum ------------------------------------------------------ */
 
@@ -446,14 +446,17 @@ vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
         else if (st.fingerprint != vf__trainer_views_fingerprint(t))
             status = vf_fail(VF_EINPUT, "%s was made from other training images or poses", path);
         else if (st.options.seconds != t->opt.seconds || st.options.steps != t->opt.steps ||
-                 st.options.keep_background != t->opt.keep_background)
+                 st.options.surroundings != t->opt.surroundings)
             /* the schedule (upsampling, pruning) is laid out over the budget: refuse a new one
              * rather than silently keep the old, so what ran is what the user asked */
-            status = vf_fail(VF_EINPUT, "the interrupted training in %s ran with a budget of "
-                             "%g%s%s; give the same budget to continue it, or --restart", path,
-                             st.options.seconds > 0 ? st.options.seconds / 60 : st.options.steps,
-                             st.options.seconds > 0 ? " minutes" : " steps",
-                             st.options.keep_background ? " with --keep-background" : "");
+            status =
+                vf_fail(VF_EINPUT,
+                        "the interrupted training in %s ran with a budget of "
+                        "%g%s and --surroundings %s; give the same to continue it, or "
+                        "--restart",
+                        path, st.options.seconds > 0 ? st.options.seconds / 60 : st.options.steps,
+                        st.options.seconds > 0 ? " minutes" : " steps",
+                        vf_field_surroundings_name(st.options.surroundings));
     }
     vf_field *f = NULL;
     if (status == VF_OK)
