@@ -26,7 +26,7 @@
 static const char usage[] =
     "usage: vfcapture ingest VIDEO|PHOTO_FOLDER -o WS [options]\n"
     "       vfcapture ingest --v4l2 /dev/videoN -o WS [--seconds S] [--size WxH] [options]\n"
-    "       vfcapture ingest --transforms FILE -o WS [options]\n"
+    "       vfcapture ingest [--transforms] FILE.json -o WS [options]\n"
     "       vfcapture ingest MODEL.glb|.gltf|.obj|.blend -o WS [--views N] [--render-size PX]\n"
     "\n"
     "Bring a capture of an object into the workspace WS (created when missing).\n"
@@ -234,6 +234,11 @@ static int parse_options(int argc, char **argv, ingest_options *opt)
     if (optind < argc)
         return vf_fail(VF_EINPUT, "unexpected argument '%s': give one video or photo folder",
                        argv[optind]);
+    size_t n = opt->source ? strlen(opt->source) : 0;
+    if (n > 5 && !strcmp(opt->source + n - 5, ".json") && !opt->transforms) {
+        opt->transforms = opt->source; /* a posed set given like a video: as `run` takes it */
+        opt->source = NULL;
+    }
     if (!!opt->source + !!opt->device + !!opt->transforms != 1)
         return vf_fail(VF_EINPUT, "give one source: a video file, a photo folder, --v4l2 DEVICE "
                                   "or --transforms FILE");

@@ -23,6 +23,8 @@ cp "$ws/ingest/transforms.json" "$tmp/before.json"
 expect 0 "info" -- "$tool" info "$ws" --json
 python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert "ingest" in d["stages"]' "$tmp/out" \
   && ok || bad "info --json lists the ingest stage"
+expect 0 "a transforms.json given like a video is imported" -- "$tool" ingest "$chair" -o "$tmp/ws_plain" --json --quiet
+json_check "the same 100 frames" 'd["frames"] == 100'
 
 # Bad input: one line, non-zero exit, the earlier import untouched.
 expect 1 "missing transforms" -- "$tool" ingest --transforms "$tmp/nope.json" -o "$ws"
