@@ -273,8 +273,8 @@ static double run_batch(vf_field_trainer *t, const uint32_t *pixels, const float
     /* Rays of opaque photos end on a surface: an unconstrained field of a room learns faint
      * haze over the white background instead. The fox at 3 minutes: 20.85 and 21.08 dB
      * held-out with a weight of 0.1, 20.09 and 19.85 dB without (its rays also end sooner:
-     * 1.7-2x the steps); 0.3 gave 21.68 dB with the whole-view box, but 21.90 against 23.05-23.13
-     * dB at 0.1 with today's 0.6 box. */
+     * 1.7-2x the steps); 0.3 gave 21.68 dB with the whole-view box, but with the 0.6 box
+     * (carve.c) 21.90 dB against 23.05-23.13 dB at 0.1. */
     const float opaque = t->has_alpha ? 0.0f : t->opt.opaque;
     double sse = 0;
 #pragma omp parallel for num_threads(t->threads) schedule(dynamic, TRAIN_TILE * TRAIN_TILE) reduction(+ : sse, total)
