@@ -34,10 +34,11 @@
 #include "vf/image.h"
 #include "vf/log.h"
 #include "vf/metrics.h"
+#include "vf/plot.h"
 #include "vf/pose.h"
-#include "vf/viewfool.h"
 #include "vf/resources.h"
 #include "vf/rng.h"
+#include "vf/viewfool.h"
 
 typedef struct view_set {
     int count;
@@ -229,25 +230,17 @@ static vf_field *train(const vf_field_train_options *opt, const view_set *views,
 
 static const char *dump_dir; /* --dump: held-out photo | render pairs go here */
 
-/* Save photo and render side by side as DIR/NAME_VIEW.png. */
-static void dump_pair(const char *name, int view, const vf_image *photo, const vf_image *render)
+/* Save photo and render side by side, with the render's PSNR, as DIR/NAME_VIEW.png. */
+static void dump_pair(const char *name, int view, const vf_image *photo, const vf_image *render,
+                      double psnr)
 {
-    vf_image pair = {0};
-    if (vf_image_alloc(&pair, 2 * photo->width, photo->height, 3) != VF_OK)
-        die("allocating");
-    for (int y = 0; y < photo->height; y++)
-        for (int x = 0; x < photo->width; x++)
-            for (int c = 0; c < 3; c++) {
-                size_t i = ((size_t)y * photo->width + x) * 3 + c;
-                size_t o = ((size_t)y * pair.width + x) * 3 + c;
-                pair.data[o] = photo->data[i];
-                pair.data[o + (size_t)photo->width * 3] = render->data[i];
-            }
-    char path[4096];
+    const vf_image pair[2] = {*photo, *render};
+    char caption[32], path[4096];
+    snprintf(caption, sizeof caption, "render %.2f dB", psnr);
+    const char *captions[2] = {"photo", caption};
     snprintf(path, sizeof path, "%s/%s_%02d.png", dump_dir, name, view);
-    if (vf_image_save(path, &pair) != VF_OK)
+    if (vf_contact_sheet(path, pair, captions, NULL, 2, 2) != VF_OK)
         die(path);
-    vf_image_free(&pair);
 }
 
 static void evaluate(const char *name, const vf_field *f, const view_set *test, const float bg[3],
@@ -259,10 +252,11 @@ static void evaluate(const char *name, const vf_field *f, const view_set *test, 
         if (vf_field_render(f, &test->cameras[i], test->c2w + 16 * i, &render) != VF_OK)
             die("rendering");
         target_rgb(&test->images[i], bg, &truth);
-        psnr += vf_image_psnr(&render, &truth);
+        const double p = vf_image_psnr(&render, &truth);
+        psnr += p;
         ssim += vf_image_ssim(&render, &truth);
         if (dump_dir)
-            dump_pair(name, i, &truth, &render);
+            dump_pair(name, i, &truth, &render, p);
         vf_image_free(&render);
         vf_image_free(&truth);
     }
@@ -325,34 +319,38 @@ static int compare_doubles(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* Median time of a 224x224 classifier-camera render at each photo's pose (a capture's own
- * frame is not ViewFool's object frame, so its photos give the viewpoints). */
-static double render_ms_at_photos(const vf_field *f, const view_set *views)
+/* Times in ms, sorted, of 224x224 classifier-camera renders at n poses (c2w: n 4x4). */
+static void render_times(const vf_field *f, const double *c2w, int n, double *times)
 {
     vf_camera cam = vf_field_classifier_camera(f, 224);
-    double *times = malloc(sizeof(double) * (size_t)views->count);
     vf_image img = {0};
-    for (int i = 0; i < views->count; i++) {
+    for (int i = 0; i < n; i++) {
         double t0 = vf_now();
-        if (vf_field_render(f, &cam, views->c2w + 16 * i, &img) != VF_OK)
+        if (vf_field_render(f, &cam, c2w + 16 * i, &img) != VF_OK)
             die("render");
         times[i] = (vf_now() - t0) * 1000;
     }
-    qsort(times, (size_t)views->count, sizeof *times, compare_doubles);
+    qsort(times, (size_t)n, sizeof *times, compare_doubles);
+    vf_image_free(&img);
+}
+
+/* Median render time at each photo's pose (a capture's own frame is not ViewFool's object
+ * frame, so its photos give the viewpoints). */
+static double render_ms_at_photos(const vf_field *f, const view_set *views)
+{
+    double *times = malloc(sizeof(double) * (size_t)views->count);
+    render_times(f, views->c2w, views->count, times);
     double median = times[views->count / 2];
     free(times);
-    vf_image_free(&img);
     return median;
 }
 
 static void bench_render(const vf_field *f)
 {
-    vf_camera cam = vf_field_classifier_camera(f, 224);
     vf_rng rng;
     vf_rng_seed(&rng, 7);
     enum { N = 60 };
-    double times[N];
-    vf_image img = {0};
+    double times[N], c2w[16 * N];
     vf_view_bounds box;
     vf_view_bounds_default(&box);
     for (int i = 0; i < N; i++) {
@@ -360,25 +358,13 @@ static void bench_render(const vf_field *f)
         for (int k = 0; k < 6; k++)
             a[k] = box.lo[k] + (box.hi[k] - box.lo[k]) * vf_rng_uniform(&rng);
         vf_viewpoint v = vf_viewpoint_from_array(a);
-        double c2w[16];
-        vf_viewpoint_to_c2w(&v, c2w);
-        double t0 = vf_now();
-        if (vf_field_render(f, &cam, c2w, &img) != VF_OK)
-            die("render");
-        times[i] = (vf_now() - t0) * 1000;
+        vf_viewpoint_to_c2w(&v, c2w + 16 * i);
     }
-    /* median: sort */
-    for (int i = 1; i < N; i++)
-        for (int j = i; j > 0 && times[j] < times[j - 1]; j--) {
-            double s = times[j];
-            times[j] = times[j - 1];
-            times[j - 1] = s;
-        }
+    render_times(f, c2w, N, times);
     printf("render 224x224 (random ViewFool viewpoints, %d threads): median %.1f ms, min %.1f, "
            "max %.1f  %s\n",
            omp_get_max_threads(), times[N / 2], times[0], times[N - 1],
            times[N / 2] < 25 ? "(target met)" : "(BELOW TARGET)");
-    vf_image_free(&img);
 }
 
 int main(int argc, char **argv)
@@ -489,7 +475,9 @@ int main(int argc, char **argv)
     /* real captures (the fox, each --transforms): 3 minutes, or each of --minutes */
     for (int c = 0; c < capture_count; c++)
         for (int m = 0; m < (minutes_given ? minute_count : 1); m++) {
-            const char *name = c == 0 && want_fox ? "fox" : "capture";
+            char name[24] = "fox"; /* "capture1"... for the --transforms sets */
+            if (c > 0 || !want_fox)
+                snprintf(name, sizeof name, "capture%d", c + !want_fox);
             view_set train_views, held, all;
             load_views(captures[c], 8, &train_views, &held);
             vf_field_train_options opt = base;
