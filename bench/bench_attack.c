@@ -205,7 +205,7 @@ static const result *measure(bench *b, const char *method, vf_view_space space, 
     cfg.lambda = lambda;
     vf_attack_state st;
     if (vf_attack_init(&st, &cfg) != VF_OK ||
-        vf_attack_run(&st, &cfg, vf_view_loss_fn, b->vl, note_step, &t0) != VF_OK)
+        vf_attack_optimize(&st, &cfg, vf_view_loss_fn, b->vl, note_step, &t0) != VF_OK)
         die(method);
     r->attack_s = vf_now() - t0;
     double t1 = vf_now();

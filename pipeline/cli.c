@@ -86,3 +86,11 @@ int cli_parse_int(const char *text, long lo, long hi, long *out)
     *out = value;
     return 0;
 }
+
+vf_status cli_open_trained(const char *root, vf_workspace *ws, vf_field **field)
+{
+    vf_status s = vf_workspace_open(root, 0, ws);
+    if (s == VF_OK && (s = vf_field_load_workspace(ws, field)) != VF_OK)
+        vf_workspace_close(ws);
+    return s;
+}

@@ -11,6 +11,8 @@
 #include <stdio.h>
 
 #include "vf/error.h"
+#include "vf/field.h"
+#include "vf/workspace.h"
 
 /* The long options every command accepts; put CLI_COMMON_OPTIONS first in its table. */
 enum { CLI_OPT_JSON = 1000, CLI_OPT_ENGINE, CLI_OPT_FIRST_CUSTOM = 1100 };
@@ -56,6 +58,10 @@ void cli_print_json(json_t *doc);
 int cli_parse_doubles(const char *text, double *out, int max);
 /* Parse a whole-string integer within [lo, hi]; returns 0 on success. */
 int cli_parse_int(const char *text, long lo, long hi, long *out);
+
+/* Open the workspace at root (never created) and its trained field; on failure nothing stays
+ * open. For the commands that only look at a field (render, eval, transfer). */
+vf_status cli_open_trained(const char *root, vf_workspace *ws, vf_field **field);
 
 /* Commands (one file each in pipeline/). */
 int cmd_ingest(int argc, char **argv);

@@ -108,14 +108,6 @@ static json_t *top_json(const int *idx, const float *p, int k)
     return list;
 }
 
-static int in_label_set(const classify_options *opt, int cls)
-{
-    for (int i = 0; i < opt->label_count; i++)
-        if (opt->labels[i] == cls)
-            return 1;
-    return 0;
-}
-
 static void print_top(const char *image, const int *idx, const float *p, int k,
                       const char *verdict)
 {
@@ -157,7 +149,7 @@ static vf_status classify_all(vf_classifier *cls, const classify_options *opt, j
         for (int i = 0; i < n && status == VF_OK; i++) {
             vf_topk(probs + (size_t)i * VF_NUM_CLASSES, opt->top, idx, p);
             const char *image = opt->images[first + i];
-            int right = in_label_set(opt, idx[0]);
+            int right = vf_label_set_contains(opt->labels, opt->label_count, idx[0]);
             *correct += right;
             const char *verdict = !opt->label_count ? "" : right ? "  (correct)" : "  (WRONG)";
             if (list) {

@@ -3,7 +3,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "attack_ws.h"
 #include "cli.h"
 #include "vf/dataset.h"
 #include "vf/log.h"
@@ -123,7 +122,7 @@ int cmd_eval(int argc, char **argv)
     vf_workspace ws;
     vf_field *field = NULL;
     if (status == VF_OK)
-        status = attack_ws_open(opt.workspace, &ws, &field);
+        status = cli_open_trained(opt.workspace, &ws, &field);
     if (status != VF_OK) {
         vf_dataset_free(&test);
         return cli_fail("eval", status);

@@ -12,6 +12,7 @@
 #include "cli.h"
 #include "physical.h"
 #include "shot_card.h"
+#include "vf/attack_file.h"
 #include "vf/calib.h"
 #include "vf/classifier.h"
 #include "vf/field.h"

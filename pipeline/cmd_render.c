@@ -2,7 +2,6 @@
  * camera pose, framed as the classifier sees it. */
 #include <string.h>
 
-#include "attack_ws.h"
 #include "cli.h"
 #include "vf/log.h"
 #include "vf/pose.h"
@@ -85,7 +84,7 @@ int cmd_render(int argc, char **argv)
     vf_workspace ws;
     vf_field *field = NULL;
     if (status == VF_OK)
-        status = attack_ws_open(opt.workspace, &ws, &field);
+        status = cli_open_trained(opt.workspace, &ws, &field);
     if (status != VF_OK)
         return cli_fail("render", status);
     vf_camera cam = vf_field_classifier_camera(field, opt.size);

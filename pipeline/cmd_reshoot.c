@@ -14,6 +14,7 @@
 #include "cli.h"
 #include "frames_in.h"
 #include "physical.h"
+#include "vf/attack_file.h"
 #include "vf/calib.h"
 #include "vf/log.h"
 #include "vf/overlay.h"

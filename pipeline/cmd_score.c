@@ -12,6 +12,7 @@
 #include "cli.h"
 #include "frames_in.h"
 #include "physical.h"
+#include "vf/attack_file.h"
 #include "vf/classifier.h"
 #include "vf/log.h"
 #include "vf/resources.h"

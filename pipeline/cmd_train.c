@@ -1,25 +1,8 @@
-/* vfcapture train: fit a radiance field to the workspace's posed images.
- *
- * Views come from WS/poses/transforms_undistorted.json (a capture) or WS/ingest/transforms.json
- * (an imported posed set). Every Nth view is held out and scored (PSNR, SSIM) after training.
- * The trainer checkpoints into the stage's staging folder, so an interrupted run continues from
- * there; WS/train/ gets model.vff, report.json and held_out.jpg (held-out photos beside their
- * renders). */
-#define _GNU_SOURCE
-#include <math.h>
-#include <stdlib.h>
-#include <string.h>
+/* vfcapture train: parse the options, run the train stage (vf/train.h), print the scores. */
+#include <stdio.h>
 
 #include "cli.h"
-#include "vf/dataset.h"
-#include "vf/field.h"
-#include "vf/log.h"
-#include "vf/metrics.h"
-#include "vf/plot.h"
-#include "vf/workspace.h"
-
-#define CHECKPOINT_SECONDS 30.0
-#define CHECKPOINT_FILE "checkpoint.vfc"
+#include "vf/train.h"
 
 static const char usage[] =
     "usage: vfcapture train WS [--minutes M | --steps N] [--holdout N] [--surroundings MODE]\n"
@@ -43,16 +26,13 @@ static const char usage[] =
 
 enum { OPT_MINUTES = CLI_OPT_FIRST_CUSTOM, OPT_STEPS, OPT_HOLDOUT, OPT_SURROUNDINGS, OPT_RESTART };
 
-typedef struct train_options {
+typedef struct cli_train {
     const char *workspace;
-    double minutes;
-    int steps; /* > 0: a step budget instead of minutes */
-    int holdout, restart;
-    vf_field_surroundings surroundings;
+    vf_train_options train;
     cli_flags flags;
-} train_options;
+} cli_train;
 
-static vf_status parse_options(int argc, char **argv, train_options *opt)
+static vf_status parse_options(int argc, char **argv, cli_train *opt)
 {
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
@@ -69,28 +49,28 @@ static vf_status parse_options(int argc, char **argv, train_options *opt)
         if (cli_common_option(c, &opt->flags, "train", usage))
             continue;
         if (c == OPT_MINUTES) {
-            if (cli_parse_doubles(optarg, &opt->minutes, 1) != 1 || !(opt->minutes > 0) ||
-                opt->minutes > 600)
+            if (cli_parse_doubles(optarg, &opt->train.minutes, 1) != 1 ||
+                !(opt->train.minutes > 0) || opt->train.minutes > 600)
                 return vf_fail(VF_EINPUT, "--minutes must be a number above 0 (up to 600), not "
                                           "'%s'", optarg);
         } else if (c == OPT_STEPS) {
             if (cli_parse_int(optarg, 1, 10000000, &value) != 0)
                 return vf_fail(VF_EINPUT, "--steps must be a whole number from 1 up, not '%s'",
                                optarg);
-            opt->steps = (int)value;
+            opt->train.steps = (int)value;
         } else if (c == OPT_HOLDOUT) {
             if (cli_parse_int(optarg, 0, 1000000, &value) != 0 || value == 1)
                 return vf_fail(VF_EINPUT, "--holdout must be 0 or a whole number from 2 up, not "
                                           "'%s'", optarg);
-            opt->holdout = (int)value;
+            opt->train.holdout = (int)value;
         } else if (c == OPT_SURROUNDINGS) {
             int mode = vf_field_surroundings_parse(optarg);
             if (mode < 0)
                 return vf_fail(VF_EINPUT, "--surroundings must be auto, grid or none, not '%s'",
                                optarg);
-            opt->surroundings = (vf_field_surroundings)mode;
+            opt->train.surroundings = (vf_field_surroundings)mode;
         } else if (c == OPT_RESTART) {
-            opt->restart = 1;
+            opt->train.restart = 1;
         }
     }
     if (optind != argc - 1)
@@ -99,269 +79,35 @@ static vf_status parse_options(int argc, char **argv, train_options *opt)
     return VF_OK;
 }
 
-/* The posed views of the workspace: a capture's undistorted frames, or an imported set. */
-static vf_status load_views(const vf_workspace *ws, vf_dataset *views)
-{
-    char path[VF_PATH_MAX];
-    vf_status status = vf_workspace_training_views(ws, path, sizeof path, NULL);
-    return status == VF_OK ? vf_dataset_load(path, views) : status;
-}
-
-static int is_held_out(int frame, int holdout)
-{
-    return holdout > 0 && frame % holdout == holdout / 2;
-}
-
-/* Decode and hand the training views to the trainer; returns whether any has alpha. */
-static vf_status add_training_views(vf_field_trainer *t, const vf_dataset *views, int holdout,
-                                    int *with_alpha)
-{
-    vf_status status = VF_OK;
-    vf_progress progress;
-    vf_progress_begin(&progress, "loading views", (size_t)views->count, "images");
-    for (int i = 0; i < views->count && status == VF_OK; i++) {
-        if (is_held_out(i, holdout))
-            continue;
-        vf_image img = {0};
-        status = vf_image_load(views->frames[i].image_path, &img);
-        if (status == VF_OK) {
-            *with_alpha |= img.channels == 4;
-            status = vf_field_trainer_add_view(t, &views->frames[i].camera, views->frames[i].c2w,
-                                               &img);
-        }
-        vf_image_free(&img);
-        vf_progress_update(&progress, (size_t)i + 1, NULL);
-    }
-    if (status == VF_OK)
-        vf_progress_end(&progress);
-    return status;
-}
-
-/* Train until the budget is used, checkpointing now and then. */
-static vf_status run_training(vf_field_trainer *t, const char *checkpoint,
-                              vf_field_train_status *st)
-{
-    vf_progress progress;
-    vf_progress_begin(&progress, "training", 1000, "");
-    double last_checkpoint = vf_now();
-    vf_status status = VF_OK;
-    memset(st, 0, sizeof *st);
-    while (status == VF_OK && !st->done) {
-        status = vf_field_trainer_step(t, st);
-        if (status == VF_OK && st->step % 25 == 0) {
-            char note[160];
-            snprintf(note, sizeof note, "step %d  loss %.5f  train PSNR %.2f dB  %.0f s left",
-                     st->step, st->loss, st->psnr, st->seconds_left);
-            vf_progress_update(&progress, (size_t)(1000 * st->fraction), note);
-        }
-        if (status == VF_OK && vf_now() - last_checkpoint > CHECKPOINT_SECONDS && !st->done) {
-            status = vf_field_trainer_save_checkpoint(t, checkpoint);
-            last_checkpoint = vf_now();
-        }
-    }
-    if (status == VF_OK)
-        vf_progress_end(&progress);
-    return status;
-}
-
-#define SHEET_PAIRS 6    /* held-out photos shown beside their renders */
-#define SHEET_HEIGHT 240 /* pixels of a tile */
-
-/* A copy of img SHEET_HEIGHT pixels high, for the contact sheet. */
-static vf_status sheet_tile(const vf_image *img, vf_image *out)
-{
-    int w = (int)lround((double)img->width * SHEET_HEIGHT / img->height);
-    return vf_image_resize(img, w > 0 ? w : 1, SHEET_HEIGHT, out);
-}
-
-/* PSNR and SSIM of the held-out views; adds a per-view list to report, and writes sheet_path:
- * the first few held-out photos beside their renders. */
-static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int holdout,
-                                const char *sheet_path, json_t *report, double *mean_psnr,
-                                double *mean_ssim)
-{
-    float bg[3];
-    vf_field_background(f, bg);
-    json_t *list = json_array();
-    double psnr_sum = 0, ssim_sum = 0;
-    int n = 0, tiles = 0;
-    vf_image sheet[2 * SHEET_PAIRS] = {{0}};
-    char captions[2 * SHEET_PAIRS][96];
-    vf_status status = VF_OK;
-    for (int i = 0; i < views->count && status == VF_OK; i++) {
-        if (!is_held_out(i, holdout))
-            continue;
-        vf_image photo = {0}, render = {0};
-        status = vf_image_load_rgb(views->frames[i].image_path, bg, &photo);
-        if (status == VF_OK)
-            status = vf_field_render(f, &views->frames[i].camera, views->frames[i].c2w, &render);
-        if (status == VF_OK) {
-            double psnr = vf_image_psnr(&render, &photo), ssim = vf_image_ssim(&render, &photo);
-            psnr_sum += psnr;
-            ssim_sum += ssim;
-            n++;
-            char name[VF_PATH_MAX];
-            vf_path_basename(name, sizeof name, views->frames[i].image_path, 0);
-            json_array_append_new(list, json_pack("{s:s, s:f, s:f}", "image", name, "psnr", psnr,
-                                                  "ssim", ssim));
-            if (tiles < 2 * SHEET_PAIRS) {
-                snprintf(captions[tiles], sizeof captions[tiles], "photo %.80s", name);
-                status = sheet_tile(&photo, &sheet[tiles++]);
-                snprintf(captions[tiles], sizeof captions[tiles], "render\n%.1f dB", psnr);
-                if (status == VF_OK)
-                    status = sheet_tile(&render, &sheet[tiles++]);
-            }
-        }
-        vf_image_free(&photo);
-        vf_image_free(&render);
-    }
-    if (status == VF_OK && tiles > 0) {
-        const char *caption_list[2 * SHEET_PAIRS];
-        for (int i = 0; i < tiles; i++)
-            caption_list[i] = captions[i];
-        status = vf_contact_sheet(sheet_path, sheet, caption_list, NULL, tiles, 4);
-    }
-    for (int i = 0; i < tiles; i++)
-        vf_image_free(&sheet[i]);
-    *mean_psnr = n ? psnr_sum / n : NAN;
-    *mean_ssim = n ? ssim_sum / n : NAN;
-    json_object_set_new(report, "held_out", list);
-    return status;
-}
-
-static vf_status train(const train_options *opt, vf_workspace *ws)
-{
-    vf_dataset views = {0};
-    vf_status status = load_views(ws, &views);
-    if (status != VF_OK)
-        return status;
-    int held = 0;
-    for (int i = 0; i < views.count; i++)
-        held += is_held_out(i, opt->holdout);
-    if (views.count - held < 3) {
-        vf_dataset_free(&views);
-        return vf_fail(VF_EINPUT, "%s has %d posed views: too few to train on", ws->root,
-                       views.count);
-    }
-
-    vf_field_train_options topt;
-    vf_field_train_defaults(&topt);
-    topt.seconds = opt->steps ? 0 : 60 * opt->minutes;
-    if (opt->steps)
-        topt.steps = opt->steps;
-    topt.surroundings = opt->surroundings;
-    vf_field_trainer *t = NULL;
-    vf_stage stage;
-    char checkpoint[VF_PATH_MAX], model[VF_PATH_MAX], report_path[VF_PATH_MAX];
-    int with_alpha = 0;
-    status = opt->restart ? vf_stage_begin(ws, "train", &stage) : vf_stage_resume(ws, "train", &stage);
-    if (status != VF_OK) {
-        vf_dataset_free(&views);
-        return status;
-    }
-    if (status == VF_OK)
-        status = vf_path_join(checkpoint, sizeof checkpoint, stage.dir, CHECKPOINT_FILE);
-    if (status == VF_OK)
-        status = vf_field_trainer_create(&topt, &t);
-    if (status == VF_OK)
-        status = add_training_views(t, &views, opt->holdout, &with_alpha);
-    if (status == VF_OK && vf_is_file(checkpoint)) {
-        vf_info("resuming from the checkpoint of an interrupted run (--restart to start over)");
-        status = vf_field_trainer_resume(t, checkpoint);
-    } else if (status == VF_OK) {
-        status = vf_field_trainer_start(t);
-    }
-    vf_field_train_status st;
-    if (status == VF_OK) {
-        if (opt->steps)
-            vf_info("training on %d views (%d held out) for %d steps on all cores",
-                    views.count - held, held, opt->steps);
-        else
-            vf_info("training on %d views (%d held out) for %.1f minutes on all cores",
-                    views.count - held, held, opt->minutes);
-        status = run_training(t, checkpoint, &st);
-    }
-
-    json_t *report = json_object();
-    double psnr = NAN, ssim = NAN;
-    const vf_field *field = t ? vf_field_trainer_field(t) : NULL;
-    char sheet[VF_PATH_MAX];
-    if (status == VF_OK)
-        status = vf_path_join(sheet, sizeof sheet, stage.dir, "held_out.jpg");
-    if (status == VF_OK)
-        status = score_held_out(field, &views, opt->holdout, sheet, report, &psnr, &ssim);
-    if (status == VF_OK)
-        status = vf_path_join(model, sizeof model, stage.dir, "model.vff");
-    if (status == VF_OK)
-        status = vf_field_save(field, model);
-    if (status == VF_OK) {
-        vf_field_info info;
-        vf_field_get_info(field, &info);
-        /* what was modelled, which "auto" decides from the photos */
-        const char *kind = info.has_background_grid ? "object box + outer grid"
-                           : with_alpha             ? "object box (background-removed photos)"
-                                                    : "object box only";
-        json_object_update_new(report,
-                               json_pack("{s:i, s:i, s:i, s:f, s:s, s:s, s:[i,i,i], s:I}", "views",
-                                         views.count - held, "held_out_views", held, "steps",
-                                         st.step, "seconds", st.elapsed, "surroundings",
-                                         info.has_background_grid ? "grid" : "none", "field", kind,
-                                         "grid", info.dim[0], info.dim[1], info.dim[2], "bytes",
-                                         (json_int_t)info.bytes));
-        vf_info("field: %s", kind);
-        if (held)
-            json_object_update_new(report, json_pack("{s:f, s:f}", "held_out_psnr", psnr,
-                                                     "held_out_ssim", ssim));
-        status = vf_path_join(report_path, sizeof report_path, stage.dir, "report.json");
-    }
-    if (status == VF_OK)
-        status = vf_json_save(report_path, report);
-    vf_field_trainer_free(t);
-    vf_dataset_free(&views);
-    if (status != VF_OK) {
-        json_decref(report);
-        /* keep the staging folder (and its checkpoint) so the next run can resume */
-        return status;
-    }
-    json_t *summary = held ? json_pack("{s:f, s:f, s:i}", "held_out_psnr", psnr, "held_out_ssim",
-                                       ssim, "steps", st.step)
-                           : json_pack("{s:i}", "steps", st.step);
-    status = vf_stage_commit(&stage,
-                             json_pack("{s:f, s:i, s:i, s:s}", "minutes", opt->minutes, "steps",
-                                       opt->steps, "holdout", opt->holdout, "surroundings",
-                                       vf_field_surroundings_name(opt->surroundings)),
-                             json_incref(summary));
-    /* The checkpoint goes only once the stage is in place: after a failed commit the next run
-     * resumes from it at its end instead of training again. */
-    if (status == VF_OK && vf_workspace_path(ws, "train", CHECKPOINT_FILE, checkpoint,
-                                             sizeof checkpoint) == VF_OK)
-        remove(checkpoint);
-    if (status == VF_OK)
-        status = vf_workspace_path(ws, "train", "model.vff", model, sizeof model);
-    if (status == VF_OK) {
-        if (opt->flags.json)
-            cli_print_json(json_pack("{s:s, s:O}", "model", model, "report", report));
-        else if (held)
-            printf("trained %d steps in %.0f s; held-out views: PSNR %.2f dB, SSIM %.3f\n",
-                   st.step, st.elapsed, psnr, ssim);
-        else
-            printf("trained %d steps in %.0f s\n", st.step, st.elapsed);
-    }
-    json_decref(summary);
-    json_decref(report);
-    return status;
-}
-
 int cmd_train(int argc, char **argv)
 {
-    train_options opt = {.minutes = 3, .holdout = 10};
-    vf_status status = parse_options(argc, argv, &opt);
+    cli_train opt = {0};
+    vf_train_defaults(&opt.train);
     vf_workspace ws;
-    if (status == VF_OK)
-        status = vf_workspace_open(opt.workspace, 0, &ws);
-    if (status != VF_OK)
-        return cli_fail("train", status);
-    status = train(&opt, &ws);
-    vf_workspace_close(&ws);
-    return status == VF_OK ? 0 : cli_fail("train", status);
+    json_t *report = NULL;
+    char model[VF_PATH_MAX];
+    vf_status s = parse_options(argc, argv, &opt);
+    if (s == VF_OK && (s = vf_workspace_open(opt.workspace, 0, &ws)) == VF_OK) {
+        s = vf_train_run(&ws, &opt.train, &report);
+        if (s == VF_OK)
+            s = vf_workspace_path(&ws, "train", VF_FIELD_FILE, model, sizeof model);
+        vf_workspace_close(&ws);
+    }
+    if (s != VF_OK) {
+        json_decref(report);
+        return cli_fail("train", s);
+    }
+    double psnr = json_number_value(json_object_get(report, "held_out_psnr"));
+    double ssim = json_number_value(json_object_get(report, "held_out_ssim"));
+    double steps = json_number_value(json_object_get(report, "steps"));
+    double seconds = json_number_value(json_object_get(report, "seconds"));
+    if (opt.flags.json)
+        cli_print_json(json_pack("{s:s, s:O}", "model", model, "report", report));
+    else if (json_object_get(report, "held_out_psnr"))
+        printf("trained %.0f steps in %.0f s; held-out views: PSNR %.2f dB, SSIM %.3f\n", steps,
+               seconds, psnr, ssim);
+    else
+        printf("trained %.0f steps in %.0f s\n", steps, seconds);
+    json_decref(report);
+    return 0;
 }

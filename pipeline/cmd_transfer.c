@@ -8,10 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "attack_ws.h"
 #include "cli.h"
-#include "vf/attack_eval.h"
+#include "vf/attack_file.h"
 #include "vf/classifier.h"
+#include "vf/dataset.h"
 #include "vf/log.h"
 #include "vf/resources.h"
 #include "vf/view_loss.h"
@@ -37,15 +37,6 @@ typedef struct transfer_options {
     const char *workspace, *models, *models_dir;
     cli_flags flags;
 } transfer_options;
-
-/* What the attack left: its label set, v* and samples. */
-typedef struct attack_result {
-    int labels[VF_MAX_LABELS], label_count;
-    double v_star[VF_VIEW_DIM];
-    double samples[VF_EVAL_SAMPLES * VF_VIEW_DIM];
-    int sample_count;
-    json_t *doc;
-} attack_result;
 
 static vf_status parse_options(int argc, char **argv, transfer_options *opt)
 {
@@ -92,46 +83,6 @@ static vf_status find_models(const transfer_options *opt, char paths[][VF_PATH_M
     return *count ? VF_OK : vf_fail(VF_EINPUT, "--models names no model");
 }
 
-static vf_status read_doubles(const json_t *a, double *out, int n, const char *what)
-{
-    if (!json_is_array(a) || (int)json_array_size(a) != n)
-        return vf_fail(VF_EINPUT, "attack.json: %s must be %d numbers", what, n);
-    for (int i = 0; i < n; i++) {
-        if (!json_is_number(json_array_get(a, (size_t)i)))
-            return vf_fail(VF_EINPUT, "attack.json: %s must be numbers", what);
-        out[i] = json_number_value(json_array_get(a, (size_t)i));
-    }
-    return VF_OK;
-}
-
-static vf_status load_attack(const vf_workspace *ws, attack_result *r)
-{
-    char path[VF_PATH_MAX];
-    if (!vf_workspace_has_stage(ws, "attack"))
-        return vf_fail(VF_EINPUT, "workspace %s has no attack: run 'vfcapture attack %s' first",
-                       ws->root, ws->root);
-    vf_status s = vf_workspace_path(ws, "attack", "attack.json", path, sizeof path);
-    if (s == VF_OK)
-        s = vf_json_load(path, &r->doc);
-    if (s != VF_OK)
-        return s;
-    json_t *labels = json_object_get(json_object_get(r->doc, "label"), "indices");
-    json_t *samples = json_object_get(r->doc, "samples");
-    r->label_count = (int)json_array_size(labels);
-    r->sample_count = (int)json_array_size(samples);
-    if (r->label_count < 1 || r->label_count > VF_MAX_LABELS || r->sample_count < 1 ||
-        r->sample_count > VF_EVAL_SAMPLES)
-        return vf_fail(VF_EINPUT, "%s has no usable label set or samples: run the attack again",
-                       path);
-    for (int i = 0; i < r->label_count; i++)
-        r->labels[i] = (int)json_integer_value(json_array_get(labels, (size_t)i));
-    s = read_doubles(json_object_get(r->doc, "v_star"), r->v_star, VF_VIEW_DIM, "v_star");
-    for (int j = 0; j < r->sample_count && s == VF_OK; j++)
-        s = read_doubles(json_array_get(samples, (size_t)j), r->samples + VF_VIEW_DIM * j,
-                         VF_VIEW_DIM, "each sample");
-    return s;
-}
-
 static double fooled_rate(const vf_view_prediction *p, int n)
 {
     int fooled = 0;
@@ -142,7 +93,7 @@ static double fooled_rate(const vf_view_prediction *p, int n)
 
 /* One model: natural accuracy, ASR of v*, ASR over the samples, as a JSON row. */
 static vf_status measure_model(const char *model, const vf_field *field, const double *c2w,
-                               int views, const attack_result *r, json_t **row)
+                               int views, const vf_attack_file *r, json_t **row)
 {
     vf_classifier *cls = NULL;
     vf_view_loss *vl = NULL;
@@ -161,8 +112,11 @@ static vf_status measure_model(const char *model, const vf_field *field, const d
         s = vf_view_loss_classify(vl, r->samples, r->sample_count, pred, NULL);
     if (s == VF_OK)
         asr = fooled_rate(pred, r->sample_count);
-    if (s == VF_OK)
-        s = vf_view_loss_classify(vl, r->v_star, 1, &star, NULL);
+    if (s == VF_OK) {
+        double v_star[VF_VIEW_DIM];
+        vf_viewpoint_to_array(&r->v_star, v_star);
+        s = vf_view_loss_classify(vl, v_star, 1, &star, NULL);
+    }
     if (s == VF_OK)
         *row = json_pack("{s:s, s:s, s:i, s:f, s:f, s:f, s:o}", "model", model, "engine",
                          vf_classifier_engine(cls), "input_size",
@@ -198,25 +152,32 @@ static void print_table(const json_t *rows)
 static vf_status run(const transfer_options *opt)
 {
     static char models[MAX_MODELS][VF_PATH_MAX];
-    int model_count = 0, views = 0, real_capture;
+    int model_count = 0;
     vf_workspace ws = {0};
     vf_field *field = NULL;
+    vf_dataset natural = {0};
     double *c2w = NULL;
-    attack_result r = {0};
+    vf_attack_file r = {0};
     json_t *rows = json_array();
     vf_stage stage;
     vf_status s = find_models(opt, models, &model_count);
     if (s == VF_OK)
         s = vf_class_names_load();
     if (s == VF_OK)
-        s = attack_ws_open(opt->workspace, &ws, &field);
-    if (s == VF_OK && (s = load_attack(&ws, &r)) == VF_OK)
-        s = attack_ws_training_poses(&ws, &c2w, &views, &real_capture);
+        s = cli_open_trained(opt->workspace, &ws, &field);
+    if (s == VF_OK)
+        s = vf_attack_file_load_workspace(&ws, &r);
+    if (s == VF_OK && r.sample_count < 1)
+        s = vf_fail(VF_EINPUT, "%s/attack/attack.json has no samples: run the attack again",
+                    ws.root);
+    if (s == VF_OK && (s = vf_dataset_load_training(&ws, &natural, NULL)) == VF_OK &&
+        !(c2w = vf_dataset_poses(&natural)))
+        s = vf_fail(VF_EINTERNAL, "out of memory");
     vf_progress progress;
     vf_progress_begin(&progress, "transfer", (size_t)model_count, "models");
     for (int m = 0; m < model_count && s == VF_OK; m++) {
         json_t *row = NULL;
-        s = measure_model(models[m], field, c2w, views, &r, &row);
+        s = measure_model(models[m], field, c2w, natural.count, &r, &row);
         if (s == VF_OK)
             json_array_append_new(rows, row);
         vf_progress_update(&progress, (size_t)m + 1, NULL);
@@ -226,9 +187,8 @@ static vf_status run(const transfer_options *opt)
     char path[VF_PATH_MAX];
     json_t *doc = NULL;
     if (s == VF_OK && (s = vf_stage_begin(&ws, "transfer", &stage)) == VF_OK) {
-        doc = json_pack("{s:O, s:O, s:i, s:O}", "attack_model", json_object_get(r.doc, "model"),
-                        "label", json_object_get(r.doc, "label"), "samples", r.sample_count,
-                        "models", rows);
+        doc = json_pack("{s:s, s:O, s:i, s:O}", "attack_model", r.model, "label", r.label,
+                        "samples", r.sample_count, "models", rows);
         s = vf_path_join(path, sizeof path, stage.dir, "transfer.json");
         if (s == VF_OK)
             s = vf_json_save(path, doc);
@@ -245,7 +205,8 @@ static vf_status run(const transfer_options *opt)
     }
     json_decref(doc);
     json_decref(rows);
-    json_decref(r.doc);
+    vf_attack_file_free(&r);
+    vf_dataset_free(&natural);
     free(c2w);
     vf_field_free(field);
     vf_workspace_close(&ws);

@@ -512,3 +512,11 @@ vf_status vf_parse_label_set(const char *text, int *labels, int max, int *count)
         *count = n;
     return status;
 }
+
+int vf_label_set_contains(const int *labels, int count, int cls)
+{
+    for (int i = 0; i < count; i++)
+        if (labels[i] == cls)
+            return 1;
+    return 0;
+}

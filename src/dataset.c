@@ -239,3 +239,19 @@ void vf_dataset_free(vf_dataset *ds)
     ds->frames = NULL;
     ds->count = 0;
 }
+
+vf_status vf_dataset_load_training(const vf_workspace *ws, vf_dataset *out, int *real_capture)
+{
+    char path[VF_PATH_MAX];
+    memset(out, 0, sizeof *out);
+    vf_status s = vf_workspace_training_views(ws, path, sizeof path, real_capture);
+    return s == VF_OK ? vf_dataset_load(path, out) : s;
+}
+
+double *vf_dataset_poses(const vf_dataset *ds)
+{
+    double *c2w = malloc((size_t)(ds->count ? ds->count : 1) * 16 * sizeof *c2w);
+    for (int i = 0; c2w && i < ds->count; i++)
+        memcpy(c2w + 16 * i, ds->frames[i].c2w, 16 * sizeof *c2w);
+    return c2w;
+}

@@ -6,175 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/attack_file.h"
 #include "vf/workspace.h"
 
 #define DEG (180.0 / M_PI)
-
-/* ---- attack.json ---- */
-
-/* Six viewpoint numbers (psi, theta, phi, dx, dy, dz, or ranges of them): angles within two
- * turns, offsets within 100 camera distances, so nothing later renders from infinity. */
-static int read_six(const json_t *arr, double out[6])
-{
-    if (json_array_size(arr) != 6)
-        return 0;
-    for (int i = 0; i < 6; i++) {
-        const json_t *x = json_array_get(arr, (size_t)i);
-        if (!json_is_number(x) || !(fabs(json_number_value(x)) <= (i < 3 ? 720.0 : 400.0)))
-            return 0;
-        out[i] = json_number_value(x);
-    }
-    return 1;
-}
-
-static double number_or_nan(const json_t *doc, const char *key)
-{
-    const json_t *x = json_object_get(doc, key);
-    return json_is_number(x) ? json_number_value(x) : NAN;
-}
-
-static void read_prediction(const json_t *p, vf_sample_prediction *out)
-{
-    const json_t *cls = json_object_get(p, "class");
-    out->cls = json_is_integer(cls) ? (int)json_integer_value(cls) : -1;
-    const char *name = json_string_value(json_object_get(p, "name"));
-    snprintf(out->name, sizeof out->name, "%s", name ? name : "?");
-    out->confidence = number_or_nan(p, "confidence");
-    out->fooled = json_is_true(json_object_get(p, "fooled"));
-}
-
-static vf_status read_labels(const json_t *doc, const char *path, vf_attack_file *a)
-{
-    const json_t *label = json_object_get(doc, "label");
-    const json_t *indices = json_object_get(label, "indices"), *names = json_object_get(label, "names");
-    size_t n = json_array_size(indices);
-    if (n == 0 || n > VF_MAX_LABELS)
-        return vf_fail(VF_EINPUT, "%s: \"label\" needs \"indices\" (1 to %d class numbers)", path,
-                       VF_MAX_LABELS);
-    size_t used = 0;
-    for (size_t i = 0; i < n; i++) {
-        a->labels[i] = (int)json_integer_value(json_array_get(indices, i));
-        const char *name = json_string_value(json_array_get(names, i));
-        if (name && used < sizeof a->label_text)
-            used += (size_t)snprintf(a->label_text + used, sizeof a->label_text - used, "%s%s",
-                                     used ? ", " : "", name);
-    }
-    a->label_count = (int)n;
-    return VF_OK;
-}
-
-static void read_camera(const json_t *doc, vf_attack_file *a)
-{
-    const json_t *c = json_object_get(doc, "camera");
-    double fx = number_or_nan(c, "fl_x"), fy = number_or_nan(c, "fl_y");
-    double cx = number_or_nan(c, "cx"), cy = number_or_nan(c, "cy");
-    double w = number_or_nan(c, "w"), h = number_or_nan(c, "h");
-    /* an export renders previews with this camera: keep it to a sane size */
-    if (fx > 0 && fy > 0 && cx > 0 && cy > 0 && fx < 1e6 && fy < 1e6 && cx < 1e5 && cy < 1e5 &&
-        w >= 1 && h >= 1 && w <= 8192 && h <= 8192) {
-        a->has_camera = 1;
-        a->camera = (vf_camera){.width = (int)w, .height = (int)h, .fx = fx, .fy = fy, .cx = cx,
-                                .cy = cy};
-    }
-}
-
-/* "measure_ranges", or the paper's full ranges for files written before it existed. */
-static vf_status read_ranges(const json_t *doc, const char *path, vf_attack_file *a)
-{
-    const json_t *r = json_object_get(doc, "measure_ranges");
-    if (!r) {
-        vf_view_ranges_paper(a->range);
-        return VF_OK;
-    }
-    if (!read_six(r, a->range))
-        return vf_fail(VF_EINPUT, "%s: \"measure_ranges\" must be 6 numbers", path);
-    for (int i = 0; i < 6; i++)
-        if (!(a->range[i] > 0) || !isfinite(a->range[i]))
-            return vf_fail(VF_EINPUT, "%s: \"measure_ranges\" must be positive", path);
-    return VF_OK;
-}
-
-static vf_status read_samples(const json_t *doc, const char *path, vf_attack_file *a)
-{
-    const json_t *samples = json_object_get(doc, "samples");
-    const json_t *preds = json_object_get(doc, "sample_predictions");
-    size_t n = json_array_size(samples);
-    a->samples = malloc(sizeof(double) * 6 * (n + 1));
-    if (!a->samples)
-        return vf_fail(VF_EINTERNAL, "out of memory reading %s", path);
-    for (size_t i = 0; i < n; i++)
-        if (!read_six(json_array_get(samples, i), a->samples + 6 * i))
-            return vf_fail(VF_EINPUT, "%s: samples[%zu] is not 6 numbers", path, i);
-    a->sample_count = (int)n;
-    if (n > 0 && json_array_size(preds) == n) {
-        a->predictions = calloc(n, sizeof *a->predictions);
-        if (!a->predictions)
-            return vf_fail(VF_EINTERNAL, "out of memory reading %s", path);
-        for (size_t i = 0; i < n; i++)
-            read_prediction(json_array_get(preds, i), &a->predictions[i]);
-    }
-    return VF_OK;
-}
-
-vf_status vf_attack_file_load(const char *path, vf_attack_file *out)
-{
-    memset(out, 0, sizeof *out);
-    json_t *doc;
-    vf_status status = vf_json_load(path, &doc);
-    if (status != VF_OK)
-        return status;
-    double v[6];
-    const json_t *bounds = json_object_get(doc, "bounds");
-    if (!read_six(json_object_get(doc, "v_star"), v))
-        status = vf_fail(VF_EINPUT, "%s: \"v_star\" must be 6 numbers (psi, theta, phi, dx, dy, "
-                                    "dz)", path);
-    else if (!read_six(json_object_get(bounds, "lo"), out->lo) ||
-             !read_six(json_object_get(bounds, "hi"), out->hi))
-        status = vf_fail(VF_EINPUT, "%s: \"bounds\" needs \"lo\" and \"hi\", 6 numbers each",
-                         path);
-    for (int i = 0; status == VF_OK && i < 6; i++)
-        if (!(out->hi[i] > out->lo[i]))
-            status = vf_fail(VF_EINPUT, "%s: bounds hi[%d] must exceed lo[%d]", path, i, i);
-    if (status == VF_OK)
-        status = read_ranges(doc, path, out);
-    if (status == VF_OK)
-        status = read_labels(doc, path, out);
-    if (status == VF_OK)
-        status = read_samples(doc, path, out);
-    if (status == VF_OK) {
-        out->v_star = vf_viewpoint_from_array(v);
-        const char *model = json_string_value(json_object_get(doc, "model"));
-        snprintf(out->model, sizeof out->model, "%s", model ? model : "");
-        out->v_star_prediction.cls = -1;
-        if (json_is_object(json_object_get(doc, "v_star_prediction")))
-            read_prediction(json_object_get(doc, "v_star_prediction"), &out->v_star_prediction);
-        out->natural_accuracy = number_or_nan(doc, "natural_accuracy");
-        out->asr_v_star = number_or_nan(doc, "asr_v_star");
-        out->asr_samples = number_or_nan(doc, "asr_samples");
-        read_camera(doc, out);
-    }
-    json_decref(doc);
-    if (status != VF_OK)
-        vf_attack_file_free(out);
-    return status;
-}
-
-void vf_attack_file_free(vf_attack_file *a)
-{
-    free(a->samples);
-    free(a->predictions);
-    a->samples = NULL;
-    a->predictions = NULL;
-    a->sample_count = 0;
-}
-
-int vf_attack_is_label(const vf_attack_file *a, int cls)
-{
-    for (int i = 0; i < a->label_count; i++)
-        if (a->labels[i] == cls)
-            return 1;
-    return 0;
-}
 
 /* ---- targets.json ---- */
 
@@ -187,8 +22,9 @@ vf_status vf_targets_file_target(const char *path, int n, vf_viewpoint *v)
     const json_t *targets = json_object_get(doc, "targets");
     size_t count = json_array_size(targets);
     double a[6];
-    int ok = n >= 0 && (size_t)n < count &&
-             read_six(json_object_get(json_array_get(targets, (size_t)n), "viewpoint"), a);
+    int ok =
+        n >= 0 && (size_t)n < count &&
+        vf_json_read_view(json_object_get(json_array_get(targets, (size_t)n), "viewpoint"), a);
     json_decref(doc);
     if (!ok)
         return vf_fail(VF_EINPUT, "%s has no usable target %d (it lists %zu, from 0)", path, n,

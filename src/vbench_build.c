@@ -9,6 +9,7 @@
 #include <jansson.h>
 #include <unistd.h>
 
+#include "vf/attack_file.h"
 #include "vf/dataset.h"
 #include "vf/field.h"
 #include "vf/log.h"
@@ -24,107 +25,35 @@
 typedef struct vbench_object {
     char name[128];
     vf_field *field;
-    json_t *labels;      /* {"indices": [...], "names": [...]} from attack.json */
-    vf_view_bounds bounds;
-    int components;
-    double mu[VF_ATTACK_MAX_COMPONENTS][VF_VIEW_DIM];
-    double sigma[VF_ATTACK_MAX_COMPONENTS][VF_VIEW_DIM];
-    double weight[VF_ATTACK_MAX_COMPONENTS];
-    vf_dataset natural;  /* the training cameras */
+    vf_attack_file attack; /* the label set and p*(v) */
+    vf_dataset natural;    /* the training cameras */
 } vbench_object;
 
 static void object_free(vbench_object *o)
 {
     vf_field_free(o->field);
-    json_decref(o->labels);
+    vf_attack_file_free(&o->attack);
     vf_dataset_free(&o->natural);
     memset(o, 0, sizeof *o);
-}
-
-static vf_status read_vector(const json_t *array, double *out, const char *what, const char *path)
-{
-    if (!json_is_array(array) || json_array_size(array) != VF_VIEW_DIM)
-        return vf_fail(VF_EINPUT, "%s: \"%s\" must hold %d numbers", path, what, VF_VIEW_DIM);
-    for (int i = 0; i < VF_VIEW_DIM; i++) {
-        const json_t *x = json_array_get(array, (size_t)i);
-        if (!json_is_number(x))
-            return vf_fail(VF_EINPUT, "%s: \"%s\" must hold numbers", path, what);
-        out[i] = json_number_value(x);
-    }
-    return VF_OK;
-}
-
-/* mu and sigma are one 6-vector (a single Gaussian) or a list of them (a mixture). */
-static vf_status read_components(const json_t *attack, vbench_object *o, const char *path)
-{
-    const json_t *mu = json_object_get(attack, "mu"), *sigma = json_object_get(attack, "sigma");
-    const json_t *weights = json_object_get(attack, "weights");
-    int mixture = json_is_array(mu) && json_is_array(json_array_get(mu, 0));
-    o->components = mixture ? (int)json_array_size(mu) : 1;
-    if (o->components < 1 || o->components > VF_ATTACK_MAX_COMPONENTS ||
-        (mixture && json_array_size(sigma) != json_array_size(mu)))
-        return vf_fail(VF_EINPUT, "%s: \"mu\" and \"sigma\" do not describe a distribution", path);
-    vf_status status = VF_OK;
-    for (int c = 0; c < o->components && status == VF_OK; c++) {
-        status = read_vector(mixture ? json_array_get(mu, (size_t)c) : mu, o->mu[c], "mu", path);
-        if (status == VF_OK)
-            status = read_vector(mixture ? json_array_get(sigma, (size_t)c) : sigma, o->sigma[c],
-                                 "sigma", path);
-        const json_t *w = json_array_get(weights, (size_t)c);
-        o->weight[c] = json_is_number(w) ? json_number_value(w) : 1.0 / o->components;
-    }
-    return status;
-}
-
-static vf_status load_attack(const vf_workspace *ws, vbench_object *o)
-{
-    char path[VF_PATH_MAX];
-    json_t *attack = NULL;
-    vf_status status = vf_workspace_path(ws, "attack", "attack.json", path, sizeof path);
-    if (status == VF_OK && !vf_workspace_has_stage(ws, "attack"))
-        status = vf_fail(VF_EINPUT, "%s has no attack yet: run 'vfcapture attack %s' first",
-                         ws->root, ws->root);
-    if (status == VF_OK)
-        status = vf_json_load(path, &attack);
-    const json_t *labels = json_object_get(attack, "label");
-    const json_t *bounds = json_object_get(attack, "bounds");
-    if (status == VF_OK && (!json_is_array(json_object_get(labels, "indices")) || !bounds))
-        status = vf_fail(VF_EINPUT, "%s: no \"label\" indices or \"bounds\"", path);
-    if (status == VF_OK)
-        status = read_vector(json_object_get(bounds, "lo"), o->bounds.lo, "bounds.lo", path);
-    if (status == VF_OK)
-        status = read_vector(json_object_get(bounds, "hi"), o->bounds.hi, "bounds.hi", path);
-    if (status == VF_OK)
-        status = read_components(attack, o, path);
-    if (status == VF_OK)
-        o->labels = json_incref((json_t *)labels);
-    json_decref(attack);
-    return status;
-}
-
-/* The cameras the field was trained on. */
-static vf_status load_natural_views(const vf_workspace *ws, vf_dataset *out)
-{
-    char path[VF_PATH_MAX];
-    vf_status status = vf_workspace_training_views(ws, path, sizeof path, NULL);
-    return status == VF_OK ? vf_dataset_load(path, out) : status;
 }
 
 static vf_status load_object(const char *root, vbench_object *o)
 {
     vf_workspace ws;
-    char model[VF_PATH_MAX];
     vf_status status = vf_workspace_open(root, 0, &ws);
     if (status != VF_OK)
         return status;
     vf_path_basename(o->name, sizeof o->name, ws.root, 0);
-    status = load_attack(&ws, o);
+    status = vf_attack_file_load_workspace(&ws, &o->attack);
+    if (status == VF_OK && o->attack.components < 1)
+        status = vf_fail(VF_EINPUT,
+                         "%s: the attack kept no distribution p*(v) (random search): "
+                         "run it with --method nes",
+                         ws.root);
     if (status == VF_OK)
-        status = vf_workspace_path(&ws, "train", "model.vff", model, sizeof model);
+        status = vf_field_load_workspace(&ws, &o->field);
     if (status == VF_OK)
-        status = vf_field_load(model, &o->field);
-    if (status == VF_OK)
-        status = load_natural_views(&ws, &o->natural);
+        status = vf_dataset_load_training(&ws, &o->natural, NULL);
     vf_workspace_close(&ws);
     return status;
 }
@@ -153,15 +82,7 @@ static void choose_view(const vbench_object *o, vf_vbench_split split, int i, in
         vf_viewpoint_to_array(&p, v);
         return;
     }
-    double pick = vf_rng_uniform(rng), total = 0;
-    int c = 0;
-    for (; c < o->components - 1; c++)
-        if ((total += o->weight[c]) > pick)
-            break;
-    double u[VF_VIEW_DIM];
-    for (int d = 0; d < VF_VIEW_DIM; d++)
-        u[d] = o->mu[c][d] + o->sigma[c][d] * vf_rng_normal(rng);
-    vf_view_squash(&o->bounds, u, v);
+    (void)vf_attack_file_sample(&o->attack, rng, 1, v); /* load_object checked there is p*(v) */
     vf_viewpoint p = vf_viewpoint_from_array(v);
     vf_viewpoint_to_c2w(&p, c2w);
 }
@@ -256,9 +177,8 @@ static vf_status write_set(vbench_object *objects, int n, const char *dir,
     size_t done = 0;
     vf_progress_begin(&progress, "rendering", (size_t)n * 2 * opt->count, "images");
     for (int o = 0; o < n && status == VF_OK; o++) {
-        json_array_append_new(object_list,
-                              json_pack("{s:s, s:O}", "name", objects[o].name, "label",
-                                        objects[o].labels));
+        json_array_append_new(object_list, json_pack("{s:s, s:O}", "name", objects[o].name,
+                                                     "label", objects[o].attack.label));
         for (int split = 0; split < 2 && status == VF_OK; split++)
             status = render_split(&objects[o], o, (vf_vbench_split)split, opt, dir, index, csv,
                                   &progress, &done);

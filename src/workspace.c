@@ -3,6 +3,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -33,6 +34,27 @@ vf_status vf_json_load(const char *path, json_t **out)
     if (!*out)
         return vf_fail(VF_EINPUT, "%s is not valid JSON (line %d: %s)", path, err.line, err.text);
     return VF_OK;
+}
+
+json_t *vf_json_doubles(const double *x, int n)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < n; i++)
+        json_array_append_new(a, json_real(x[i]));
+    return a;
+}
+
+int vf_json_read_doubles(const json_t *array, double *out, int n)
+{
+    if (!json_is_array(array) || json_array_size(array) != (size_t)n)
+        return 0;
+    for (int i = 0; i < n; i++) {
+        const json_t *x = json_array_get(array, (size_t)i);
+        if (!json_is_number(x) || !isfinite(json_number_value(x)))
+            return 0;
+        out[i] = json_number_value(x);
+    }
+    return 1;
 }
 
 static int folder_is_empty(const char *path)

@@ -80,7 +80,7 @@ int main(void)
     vf_attack_state st;
     double t0 = vf_now();
     CHECK(vf_attack_init(&st, &cfg) == VF_OK &&
-              vf_attack_run(&st, &cfg, vf_view_loss_fn, vl, NULL, NULL) == VF_OK,
+              vf_attack_optimize(&st, &cfg, vf_view_loss_fn, vl, NULL, NULL) == VF_OK,
           "attack: %s", vf_error_message());
     double attack_s = vf_now() - t0;
 

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "vf/attack_file.h"
 #include "vf/localize.h"
 #include "vf/targets.h"
 #include "vf/wilson.h"

@@ -309,7 +309,7 @@ static void test_gradient_mixture(void)
 static void run_attack(vf_attack_config *cfg, objective *o, vf_attack_state *st)
 {
     CHECK(vf_attack_init(st, cfg) == VF_OK, "init: %s", vf_error_message());
-    CHECK(vf_attack_run(st, cfg, objective_fn, o, NULL, NULL) == VF_OK, "run: %s",
+    CHECK(vf_attack_optimize(st, cfg, objective_fn, o, NULL, NULL) == VF_OK, "run: %s",
           vf_error_message());
     CHECK(st->step == cfg->steps, "ran %d of %d steps", st->step, cfg->steps);
 }
@@ -599,7 +599,8 @@ static void check_resume(vf_attack_config *cfg, objective *o, int split, const c
     CHECK(loaded != NULL, "%s: state JSON round trip", what);
     CHECK(vf_attack_state_from_json(loaded, &resumed) == VF_OK, "%s: from JSON: %s", what,
           vf_error_message());
-    CHECK(vf_attack_run(&resumed, cfg, objective_fn, o, NULL, NULL) == VF_OK, "%s: resume", what);
+    CHECK(vf_attack_optimize(&resumed, cfg, objective_fn, o, NULL, NULL) == VF_OK, "%s: resume",
+          what);
 
     CHECK(memcmp(straight.mu, resumed.mu, sizeof straight.mu) == 0 &&
               memcmp(straight.sigma, resumed.sigma, sizeof straight.sigma) == 0 &&

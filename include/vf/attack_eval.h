@@ -56,12 +56,6 @@ vf_status vf_attack_eval_distribution(vf_view_loss *vl, const vf_attack_state *s
 vf_status vf_attack_eval_random(vf_view_loss *vl, const vf_view_bounds *bounds, uint64_t seed,
                                 vf_attack_eval *out);
 
-/* The contract keys: "v_star", "v_star_prediction", "asr_v_star", "v_best",
- * "v_best_prediction", "asr_v_best", "measure_ranges" (vf_view_ranges_paper), "samples",
- * "sample_predictions", "asr_samples", "sample_std", "fluctuation" {"r_percent", "asr",
- * "samples_per_level"}, "top_wrong_classes" [{"class","name","count"}]. A new object. */
-json_t *vf_attack_eval_to_json(const vf_attack_eval *ev);
-
 /* One prediction as {"class", "name", "confidence", "label_probability", "fooled"}. */
 json_t *vf_view_prediction_to_json(const vf_view_prediction *p);
 

@@ -137,6 +137,9 @@ const char *vf_class_short_name(int i);
  * range, unknown, or ambiguous (a synonym of several classes, such as "crane": give the index). */
 vf_status vf_parse_label_set(const char *text, int *labels, int max, int *count);
 
+/* Whether class cls is one of the count labels: the top-1 is correct when it is. */
+int vf_label_set_contains(const int *labels, int count, int cls);
+
 #ifdef __cplusplus
 }
 #endif

@@ -35,6 +35,15 @@ typedef struct vf_dataset {
  * gives w/h). Errors name the file and the missing or malformed field. */
 vf_status vf_dataset_load(const char *transforms_path, vf_dataset *out);
 
+/* The posed frames the field of a workspace trains on (vf_workspace_training_views picks the
+ * file; *real_capture, may be NULL, is 1 for frames the poses stage posed). */
+struct vf_workspace;
+vf_status vf_dataset_load_training(const struct vf_workspace *ws, vf_dataset *out,
+                                   int *real_capture);
+
+/* The frames' camera-to-world matrices, count x 16 in a new array (NULL when out of memory). */
+double *vf_dataset_poses(const vf_dataset *ds);
+
 /* Write a transforms file (atomically) with per-frame intrinsics; image paths are written
  * relative to the JSON file's folder when they lie under it. */
 vf_status vf_dataset_save(const char *transforms_path, const vf_dataset *ds);

@@ -100,6 +100,12 @@ vf_status vf_field_save(const vf_field *f, const char *path);
  * missing, not a field, from another format version, truncated or corrupt. */
 vf_status vf_field_load(const char *path, vf_field **out);
 
+#define VF_FIELD_FILE "model.vff" /* the train stage's field, WS/train/model.vff */
+
+/* The trained field of a workspace. VF_EINPUT saying to run train first when there is none. */
+struct vf_workspace;
+vf_status vf_field_load_workspace(const struct vf_workspace *ws, vf_field **out);
+
 /* Release a field; NULL is fine. */
 void vf_field_free(vf_field *f);
 

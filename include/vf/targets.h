@@ -12,60 +12,24 @@
  * (world up points up in the picture) and positive when the camera is turned clockwise as
  * its user sees it; an upside-down view has roll +-180.
  *
- * Memory: vf_attack_file_load fills a struct that owns its arrays (vf_attack_file_free);
- * everything else works on caller-owned plain values. */
+ * Everything works on caller-owned plain values. attack.json itself is read through
+ * vf/attack_file.h. */
 #ifndef VF_TARGETS_H
 #define VF_TARGETS_H
 
-#include "vf/camera.h"
-#include "vf/classifier.h"
 #include "vf/error.h"
 #include "vf/fsutil.h"
 #include "vf/pose.h"
-#include "vf/viewfool.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* ---- attack.json, as far as the physical loop reads it ---- */
-
-typedef struct vf_sample_prediction {
-    int cls;                 /* predicted class index, -1 when unknown */
-    char name[96];
-    double confidence;
-    int fooled;
-} vf_sample_prediction;
-
-typedef struct vf_attack_file {
-    char model[VF_PATH_MAX];        /* classifier the attack used ("" when not given) */
-    int label_count;
-    int labels[VF_MAX_LABELS];      /* the true label set */
-    char label_text[256];           /* its names, comma-separated */
-    double lo[6], hi[6];            /* the attack's search box */
-    double range[6];                /* measurement ranges ("measure_ranges"; the paper's full
-                                     * ranges when absent): tolerances are shares of these */
-    vf_viewpoint v_star;
-    int sample_count;
-    double *samples;                /* sample_count x 6: the samples of p*(v) */
-    vf_sample_prediction *predictions; /* sample_count entries, or NULL when absent */
-    vf_sample_prediction v_star_prediction; /* cls -1 when attack.json does not say */
-    double natural_accuracy, asr_v_star, asr_samples; /* NAN when absent */
-    int has_camera;
-    vf_camera camera;               /* the render camera */
-} vf_attack_file;
-
-/* Read attack.json. VF_EINPUT naming the file and the missing key ("v_star", "bounds",
- * "label") when it cannot be used; samples, predictions, rates and camera are optional. */
-vf_status vf_attack_file_load(const char *path, vf_attack_file *out);
-void vf_attack_file_free(vf_attack_file *a);
+/* ---- targets.json ---- */
 
 /* The viewpoint of target n (from 0) of an export's targets.json. VF_EINPUT naming the file
  * when there is no such target or its six numbers are not finite and in range. */
 vf_status vf_targets_file_target(const char *path, int n, vf_viewpoint *v);
-
-/* Whether class `cls` belongs to the attack's label set. */
-int vf_attack_is_label(const vf_attack_file *a, int cls);
 
 /* ---- viewpoints in words ---- */
 

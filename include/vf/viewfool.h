@@ -65,6 +65,13 @@ void vf_view_bounds_default(vf_view_bounds *bounds);
 /* VF_EINPUT unless every lo < hi and both are finite. */
 vf_status vf_view_bounds_check(const vf_view_bounds *bounds);
 
+/* "psi", "theta", "phi", "dx", "dy", "dz" for i = 0..5 ("?" otherwise). */
+const char *vf_view_param_name(int i);
+
+/* Replace the parameters named in text, "psi=-90:90,phi=100:160" (lo < hi, finite), leaving
+ * the others as they are. VF_EINPUT naming the item that does not parse. */
+vf_status vf_view_bounds_parse(const char *text, vf_view_bounds *bounds);
+
 /* The paper's full range of each parameter, the widths of the default box: psi 360 deg,
  * theta 60, phi 140, dx 1, dy 2, dz 1. Camera fluctuation and the re-shoot tolerance are
  * percentages of these, not of a (narrowed) search box, so figures compare across objects. */
@@ -113,7 +120,7 @@ typedef struct vf_attack_config {
     vf_attack_method method;
     int samples;    /* k, loss evaluations per step (PEPG: the mean and (k-1)/2 antithetic
                      * pairs, k odd) */
-    int steps;      /* vf_attack_run stops when the state reaches this many steps */
+    int steps;      /* vf_attack_optimize stops when the state reaches this many steps */
     double lambda;  /* entropy weight */
     double lr;      /* step of mu: Adam (NES, in u units) or momentum SGD (PEPG) */
     uint64_t seed;  /* seeds the state's RNG at vf_attack_init */
@@ -213,15 +220,15 @@ vf_status vf_attack_state_copy(vf_attack_state *dst, const vf_attack_state *src)
 vf_status vf_attack_step(vf_attack_state *st, const vf_attack_config *cfg,
                          vf_attack_loss_fn loss_fn, void *ctx);
 
-/* Called after every step of vf_attack_run (for progress and checkpoints); a non-OK return
+/* Called after every step of vf_attack_optimize (for progress and checkpoints); a non-OK return
  * stops the run with that status. */
 typedef vf_status (*vf_attack_step_hook)(const vf_attack_state *st, void *hook_ctx);
 
 /* Step until st->step == cfg->steps (a resumed state continues where it stopped). hook may be
  * NULL. */
-vf_status vf_attack_run(vf_attack_state *st, const vf_attack_config *cfg,
-                        vf_attack_loss_fn loss_fn, void *ctx, vf_attack_step_hook hook,
-                        void *hook_ctx);
+vf_status vf_attack_optimize(vf_attack_state *st, const vf_attack_config *cfg,
+                             vf_attack_loss_fn loss_fn, void *ctx, vf_attack_step_hook hook,
+                             void *hook_ctx);
 
 /* The NES ascent direction at the current state, estimated from cfg->samples samples drawn
  * from rng (not the state's): what vf_attack_step feeds to Adam, the natural gradient of the

@@ -67,6 +67,10 @@ void vf_stage_abort(vf_stage *s);
 vf_status vf_json_save(const char *path, const json_t *doc);
 /* Load a JSON document; errors name the file and the line. */
 vf_status vf_json_load(const char *path, json_t **out);
+/* n numbers as a JSON array (a new reference). */
+json_t *vf_json_doubles(const double *x, int n);
+/* An array of exactly n finite numbers into out: 1, else 0 (out partly written). */
+int vf_json_read_doubles(const json_t *array, double *out, int n);
 
 #ifdef __cplusplus
 }

@@ -97,45 +97,9 @@ vf_status vf_attack_eval_random(vf_view_loss *vl, const vf_view_bounds *bounds, 
     return measure(vl, bounds, seed, out);
 }
 
-static json_t *doubles_json(const double *x, int n)
-{
-    json_t *a = json_array();
-    for (int i = 0; i < n; i++)
-        json_array_append_new(a, json_real(x[i]));
-    return a;
-}
-
 json_t *vf_view_prediction_to_json(const vf_view_prediction *p)
 {
     return json_pack("{s:i, s:s, s:f, s:f, s:b}", "class", p->top_class, "name",
                      vf_class_short_name(p->top_class), "confidence", (double)p->top_prob,
                      "label_probability", (double)p->label_prob, "fooled", !p->correct);
-}
-
-json_t *vf_attack_eval_to_json(const vf_attack_eval *ev)
-{
-    json_t *samples = json_array(), *preds = json_array(), *wrong = json_array();
-    for (int i = 0; i < ev->sample_count; i++) {
-        json_array_append_new(samples, doubles_json(ev->samples + VF_VIEW_DIM * i, VF_VIEW_DIM));
-        json_array_append_new(preds, vf_view_prediction_to_json(&ev->sample_pred[i]));
-    }
-    for (int i = 0; i < ev->wrong_count; i++)
-        json_array_append_new(wrong, json_pack("{s:i, s:s, s:i}", "class", ev->wrong_class[i],
-                                               "name", vf_class_short_name(ev->wrong_class[i]),
-                                               "count", ev->wrong_votes[i]));
-    double r[VF_FLUCT_LEVELS], range[VF_VIEW_DIM];
-    for (int i = 0; i < VF_FLUCT_LEVELS; i++)
-        r[i] = i + 1;
-    vf_view_ranges_paper(range);
-    return json_pack(
-        "{s:o, s:o, s:f, s:o, s:o, s:f, s:o, s:o, s:o, s:f, s:o, s:{s:o, s:o, s:i}, s:o}",
-        "v_star", doubles_json(ev->v_star, VF_VIEW_DIM), "v_star_prediction",
-        vf_view_prediction_to_json(&ev->v_star_pred), "asr_v_star", ev->asr_v_star, "v_best",
-        doubles_json(ev->v_best, VF_VIEW_DIM), "v_best_prediction",
-        vf_view_prediction_to_json(&ev->v_best_pred), "asr_v_best", ev->asr_v_best,
-        "measure_ranges", doubles_json(range, VF_VIEW_DIM), "samples", samples,
-        "sample_predictions", preds, "asr_samples", ev->asr_samples, "sample_std",
-        doubles_json(ev->sample_std, VF_VIEW_DIM), "fluctuation", "r_percent",
-        doubles_json(r, VF_FLUCT_LEVELS), "asr", doubles_json(ev->fluct_asr, VF_FLUCT_LEVELS),
-        "samples_per_level", VF_FLUCT_SAMPLES, "top_wrong_classes", wrong);
 }

@@ -77,9 +77,7 @@ static void predict(const vf_view_loss *vl, float *logits, vf_view_prediction *o
     int top;
     vf_topk(logits, 1, &top, &out->top_prob);
     out->top_class = top;
-    out->correct = 0;
-    for (int i = 0; i < vl->label_count; i++)
-        out->correct |= vl->labels[i] == top;
+    out->correct = vf_label_set_contains(vl->labels, vl->label_count, top);
     out->label_prob = (float)exp(-*loss);
 }
 

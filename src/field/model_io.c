@@ -21,6 +21,7 @@
 #include "trainer_internal.h"
 #include "vf/fsutil.h"
 #include "vf/log.h"
+#include "vf/workspace.h"
 
 #define MODEL_MAGIC "VFFIELD\n"
 #define MODEL_VERSION 1u
@@ -490,4 +491,17 @@ vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
         return status;
     t->adam.t = st.adam_t;
     return VF_OK;
+}
+
+vf_status vf_field_load_workspace(const vf_workspace *ws, vf_field **out)
+{
+    char path[VF_PATH_MAX];
+    *out = NULL;
+    if (!vf_workspace_has_stage(ws, "train"))
+        return vf_fail(VF_EINPUT,
+                       "workspace %s has no trained radiance field: run 'vfcapture "
+                       "train %s' first",
+                       ws->root, ws->root);
+    vf_status s = vf_workspace_path(ws, "train", VF_FIELD_FILE, path, sizeof path);
+    return s == VF_OK ? vf_field_load(path, out) : s;
 }

@@ -9,6 +9,7 @@
 
 #include "object3d_internal.h"
 #include "vf/attack_eval.h"
+#include "vf/attack_file.h"
 #include "vf/dataset.h"
 #include "vf/field.h"
 #include "vf/log.h"
@@ -17,7 +18,6 @@
 #include "vf/pose.h"
 #include "vf/resources.h"
 #include "vf/rng.h"
-#include "vf/targets.h"
 #include "vf/view_loss.h"
 
 #define STAGE "real"
@@ -55,17 +55,11 @@ void vf_real_defaults(vf_real_options *o)
 
 static vf_status open_inputs(real_run *r)
 {
-    char path[VF_PATH_MAX];
     vf_status s = vf_object3d_load(r->ws, &r->obj);
-    if (s == VF_OK && !vf_workspace_has_stage(r->ws, "attack"))
-        s = vf_fail(VF_EINPUT, "%s has no attack result: run 'vfcapture attack %s' first",
-                    r->ws->root, r->ws->root);
-    if (s == VF_OK && (s = vf_workspace_path(r->ws, "attack", "attack.json", path,
-                                             sizeof path)) == VF_OK)
-        s = vf_attack_file_load(path, &r->af);
-    if (s == VF_OK && (s = vf_workspace_path(r->ws, "train", "model.vff", path,
-                                             sizeof path)) == VF_OK)
-        s = vf_field_load(path, &r->field);
+    if (s == VF_OK)
+        s = vf_attack_file_load_workspace(r->ws, &r->af);
+    if (s == VF_OK)
+        s = vf_field_load_workspace(r->ws, &r->field);
     const char *name = r->o->classifier       ? r->o->classifier
                        : r->af.model[0] != 0 ? r->af.model
                                               : VF_DEFAULT_MODEL;
@@ -85,11 +79,8 @@ static vf_status open_inputs(real_run *r)
 /* The cameras: v*, the samples, the fluctuation boxes, natural training views. */
 static vf_status make_cameras(real_run *r)
 {
-    char path[VF_PATH_MAX];
     vf_dataset ds = {0};
-    vf_status s = vf_workspace_training_views(r->ws, path, sizeof path, NULL);
-    if (s == VF_OK)
-        s = vf_dataset_load(path, &ds);
+    vf_status s = vf_dataset_load_training(r->ws, &ds, NULL);
     if (s != VF_OK)
         return s;
     int natural = r->o->natural_views < ds.count ? r->o->natural_views : ds.count;

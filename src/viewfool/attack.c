@@ -143,9 +143,9 @@ vf_status vf_attack_step(vf_attack_state *st, const vf_attack_config *cfg,
                                          : vf__nes_step(st, cfg, loss_fn, ctx);
 }
 
-vf_status vf_attack_run(vf_attack_state *st, const vf_attack_config *cfg,
-                        vf_attack_loss_fn loss_fn, void *ctx, vf_attack_step_hook hook,
-                        void *hook_ctx)
+vf_status vf_attack_optimize(vf_attack_state *st, const vf_attack_config *cfg,
+                             vf_attack_loss_fn loss_fn, void *ctx, vf_attack_step_hook hook,
+                             void *hook_ctx)
 {
     while (st->step < cfg->steps) {
         vf_status status = vf_attack_step(st, cfg, loss_fn, ctx);

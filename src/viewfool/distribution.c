@@ -1,6 +1,8 @@
 /* The viewpoint box, the tanh squashing and the entropy of the squashed Gaussian. */
 #include <math.h>
 #include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "viewfool_internal.h"
@@ -9,6 +11,10 @@
 
 static const double default_lo[VF_VIEW_DIM] = {-180, -30, 20, -0.5, -1, -0.5};
 static const double default_hi[VF_VIEW_DIM] = {180, 30, 160, 0.5, 1, 0.5};
+
+static const char *const param_names[VF_VIEW_DIM] = {"psi", "theta", "phi", "dx", "dy", "dz"};
+
+const char *vf_view_param_name(int i) { return i >= 0 && i < VF_VIEW_DIM ? param_names[i] : "?"; }
 
 void vf_view_bounds_default(vf_view_bounds *bounds)
 {
@@ -55,12 +61,48 @@ void vf_view_bounds_restrict(vf_view_bounds *bounds, vf_view_space space,
 
 vf_status vf_view_bounds_check(const vf_view_bounds *bounds)
 {
-    static const char *names[VF_VIEW_DIM] = {"psi", "theta", "phi", "dx", "dy", "dz"};
     for (int i = 0; i < VF_VIEW_DIM; i++) {
         double lo = bounds->lo[i], hi = bounds->hi[i];
         if (!isfinite(lo) || !isfinite(hi) || !(lo < hi))
             return vf_fail(VF_EINPUT, "viewpoint bounds for %s are [%g, %g]: need lo < hi",
-                           names[i], lo, hi);
+                           param_names[i], lo, hi);
+    }
+    return VF_OK;
+}
+
+static int parse_number(const char *text, double *out)
+{
+    char *end;
+    *out = strtod(text, &end);
+    return end != text && *end == '\0' && isfinite(*out);
+}
+
+vf_status vf_view_bounds_parse(const char *text, vf_view_bounds *bounds)
+{
+    char buf[1024];
+    if (snprintf(buf, sizeof buf, "%s", text) >= (int)sizeof buf)
+        return vf_fail(VF_EINPUT, "the bounds text is too long");
+    char *save = NULL;
+    for (char *item = strtok_r(buf, ",", &save); item; item = strtok_r(NULL, ",", &save)) {
+        char *eq = strchr(item, '=');
+        char *colon = eq ? strchr(eq + 1, ':') : NULL;
+        int i = 0;
+        while (eq && i < VF_VIEW_DIM &&
+               (strlen(param_names[i]) != (size_t)(eq - item) ||
+                strncmp(item, param_names[i], (size_t)(eq - item))))
+            i++;
+        if (!eq || i == VF_VIEW_DIM || !colon)
+            return vf_fail(VF_EINPUT,
+                           "bounds want name=lo:hi with names psi, theta, phi, dx, "
+                           "dy, dz, not '%s'",
+                           item);
+        *colon = '\0';
+        double lo, hi;
+        if (!parse_number(eq + 1, &lo) || !parse_number(colon + 1, &hi) || !(lo < hi))
+            return vf_fail(VF_EINPUT, "bounds of %s: give two numbers lo:hi with lo < hi",
+                           param_names[i]);
+        bounds->lo[i] = lo;
+        bounds->hi[i] = hi;
     }
     return VF_OK;
 }

@@ -1,0 +1,73 @@
+/* vf/attack.h: the attack stage, ViewFool against a real classifier on a workspace's field.
+ *
+ *     vf_attack_options o;
+ *     vf_attack_defaults(&o);
+ *     o.label = "folding chair";
+ *     json_t *result;
+ *     vf_status s = vf_attack_run(&ws, &o, &result);   // WS/attack/ committed
+ *
+ * The stage: check the model and the label set before anything heavy; load the field
+ * (WS/train/model.vff) and the training cameras; classify renders at the training poses
+ * (natural accuracy, and the label set by majority vote when none is given); choose the
+ * search box (a real capture, one the poses stage posed: the range its photos cover,
+ * vf/view_coverage.h; then --space, then the caller's bounds); optimize p(v) (vf/viewfool.h)
+ * with a checkpoint a step in the staging folder; measure v*, VF_EVAL_SAMPLES samples,
+ * fluctuation and the random-search baseline (vf/attack_eval.h); write attack.json
+ * (vf/attack_file.h), v_star.png, samples.png, loss.png and fluctuation.png; commit.
+ *
+ * Life cycle: a failure after the stage began leaves its staging folder and checkpoint;
+ * `resume` continues from that checkpoint when the model, labels and settings are the same
+ * (VF_EINPUT when they differ), otherwise a run starts afresh. The checkpoint is removed only
+ * once the new output is committed. */
+#ifndef VF_ATTACK_H
+#define VF_ATTACK_H
+
+#include <jansson.h>
+#include <stdint.h>
+
+#include "vf/error.h"
+#include "vf/viewfool.h"
+#include "vf/workspace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    VF_SEARCH_NES = 0,   /* the paper's Eq. 7: natural-gradient NES with the entropy term */
+    VF_SEARCH_PEPG = 1,  /* the reference code's optimizer */
+    VF_SEARCH_RANDOM = 2 /* the baseline: VF_EVAL_SAMPLES uniform viewpoints, no optimizer */
+} vf_attack_search;
+
+/* "nes", "pepg", "random"; VF_EINPUT naming the choices otherwise. */
+vf_status vf_attack_search_parse(const char *name, vf_attack_search *out);
+const char *vf_attack_search_name(vf_attack_search m);
+
+typedef struct vf_attack_options {
+    const char *model;       /* classifier name or .onnx path (VF_DEFAULT_MODEL) */
+    const char *models_dir;  /* looked in first for a name (NULL: the usual places) */
+    const char *label;       /* label set, vf_parse_label_set's syntax; NULL: majority vote */
+    vf_attack_search method; /* VF_SEARCH_NES */
+    double lambda;           /* entropy weight; < 0: the method's default (0.01) */
+    int samples;             /* viewpoints a step; 0: the method's default (50, pepg 51) */
+    int steps;               /* optimization steps (100) */
+    int components;          /* mixture size K, 1..VF_ATTACK_MAX_COMPONENTS, nes only (1) */
+    vf_view_space space;     /* VF_SPACE_BOTH */
+    const char *bounds;      /* "psi=-90:90,..." applied last (vf_view_bounds_parse), or NULL */
+    uint64_t seed;           /* 0: the same seed gives the same result */
+    int resume;              /* continue an interrupted attack (see the top comment) */
+} vf_attack_options;
+
+void vf_attack_defaults(vf_attack_options *o);
+
+/* VF_EINPUT naming the option when the options cannot run (a method/components clash). */
+vf_status vf_attack_options_check(const vf_attack_options *o);
+
+/* Run the stage on an open workspace with a trained field. *result (may be NULL) gets
+ * attack.json's document (a new reference). Progress and the choices made go to the log. */
+vf_status vf_attack_run(vf_workspace *ws, const vf_attack_options *o, json_t **result);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

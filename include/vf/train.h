@@ -1,0 +1,51 @@
+/* vf/train.h: the train stage, a radiance field fitted to a workspace's posed images.
+ *
+ *     vf_train_options o;
+ *     vf_train_defaults(&o);
+ *     o.steps = 1500;                           // a step budget instead of 3 minutes
+ *     json_t *report;
+ *     vf_status s = vf_train_run(&ws, &o, &report);   // WS/train/ committed
+ *
+ * The views are the workspace's training views (vf_dataset_load_training: the poses stage's
+ * undistorted frames, or an imported posed set). Every holdout-th view (the middle one of
+ * each run of holdout) is held out, scored after training (PSNR, SSIM against the photo
+ * composited on the field's background) and shown beside its render in held_out.jpg. The
+ * trainer (vf/field.h) checkpoints into the staging folder every 30 s; a later run resumes
+ * from that checkpoint unless `restart` is set, and the checkpoint goes only once the stage is
+ * committed. Output: WS/train/model.vff (VF_FIELD_FILE), report.json (views, held_out_views,
+ * steps, seconds, surroundings, field, grid, bytes, held_out_psnr/ssim, held_out [per view]),
+ * held_out.jpg. */
+#ifndef VF_TRAIN_H
+#define VF_TRAIN_H
+
+#include <jansson.h>
+
+#include "vf/error.h"
+#include "vf/field.h"
+#include "vf/workspace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vf_train_options {
+    double minutes; /* wall-time budget (3) */
+    int steps;      /* > 0: this many optimizer steps instead of minutes */
+    int holdout;    /* hold out every holdout-th view for scoring; 0 none (10) */
+    vf_field_surroundings surroundings; /* VF_SURROUNDINGS_AUTO, see vf/field.h */
+    int restart;                        /* ignore a checkpoint of an interrupted run */
+} vf_train_options;
+
+void vf_train_defaults(vf_train_options *o);
+
+/* VF_EINPUT naming the option that cannot run (minutes outside (0, 600], holdout 1). */
+vf_status vf_train_options_check(const vf_train_options *o);
+
+/* Train on an open workspace. *result (may be NULL) gets report.json's document (a new
+ * reference). VF_EINPUT when there are fewer than 3 training views. */
+vf_status vf_train_run(vf_workspace *ws, const vf_train_options *o, json_t **result);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
