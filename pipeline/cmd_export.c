@@ -1,433 +1,107 @@
-/* vfcapture export: the attack's viewpoints as shots a person can take.
- *
- * From WS/attack/attack.json: target 0 is v*, targets 1..M are samples of p*(v) spread over
- * the distribution. Each gets its camera-to-world in the object frame and in COLMAP's frame
- * (normalization undone), its description in words (vf/targets.h; metres when WS/calib has a
- * scale), the predicted class, and a preview rendered from the trained field when there is
- * one. Outputs in WS/export/: targets.json, targets.csv, previews/, shot_card.png. */
-#include <math.h>
+/* vfcapture export: parse the options, run the export stage (vf/export.h), list the targets. */
+#include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include "cli.h"
-#include "physical.h"
-#include "shot_card.h"
-#include "vf/attack_file.h"
-#include "vf/calib.h"
-#include "vf/classifier.h"
-#include "vf/field.h"
-#include "vf/localize.h"
-#include "vf/log.h"
-#include "vf/resources.h"
-#include "vf/targets.h"
-#include "vf/workspace.h"
-
-#define DEFAULT_COUNT 8
-#define PREVIEW_SIZE 224
+#include "vf/export.h"
 
 static const char usage[] =
     "usage: vfcapture export WS [--count M]\n"
     "\n"
     "Turn the attack's result (WS/attack/attack.json) into target shots: v* and M samples of\n"
     "p*(v) spread over the distribution. For each: camera-to-world in the object frame and in\n"
-    "COLMAP's frame (when WS has poses), and in words (azimuth and elevation around the object centre, distance,\n"
-    "height, roll, the point looked at; metres when WS/calib/scale.json gives the scale), the\n"
-    "predicted class, and a preview rendered from WS/train/model.vff when it exists.\n"
+    "COLMAP's frame (when WS has poses), and in words (azimuth and elevation around the object\n"
+    "centre, distance, height, roll, the point looked at; metres when WS/calib/scale.json gives\n"
+    "the scale), the predicted class, and a preview rendered from WS/train/model.vff when it\n"
+    "exists.\n"
     "Writes WS/export/targets.json, targets.csv, previews/ and shot_card.png.\n"
     "\n"
     "options:\n"
-    "  -n, --count M          samples of p*(v) besides v* (default 8)\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
+    "  -n, --count M          samples of p*(v) besides v* (default 8)\n" CLI_ENGINE_HELP
+        CLI_COMMON_HELP;
 
-typedef struct target {
-    vf_viewpoint v;
-    const char *kind;         /* "v*" or "sample" */
-    int sample;               /* index into attack.json's samples, -1 for v* */
-    double c2w[16], c2w_colmap[16];
-    vf_target_words words;
-    vf_sample_prediction pred;
-    vf_image preview;
-} target;
-
-typedef struct export_run {
-    const char *ws;
-    int count;
-    vf_attack_file attack;
-    vf_similarity colmap_from_object;
-    int has_colmap;           /* the workspace has a COLMAP frame (poses stage) */
-    double metres;            /* metres per scene unit, 0 when unknown */
-    vf_field *field;
-    vf_classifier *cls;
-    target *targets;
-    int target_count;
-} export_run;
-
-static vf_status parse(int argc, char **argv, export_run *run, cli_flags *flags)
+static vf_status parse(int argc, char **argv, const char **ws, vf_export_options *o,
+                       cli_flags *flags)
 {
     static const struct option longopts[] = {CLI_COMMON_OPTIONS,
                                              CLI_ENGINE_OPTION,
                                              {"count", required_argument, NULL, 'n'},
                                              {0, 0, 0, 0}};
-    run->count = DEFAULT_COUNT;
     int c;
     long n;
     while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "n:", longopts, NULL)) != -1) {
         if (cli_common_option(c, flags, "export", usage))
             continue;
         if (c == 'n') {
-            if (cli_parse_int(optarg, 0, 1000, &n))
-                return vf_fail(VF_EINPUT, "--count: give a number from 0 to 1000");
-            run->count = (int)n;
+            if (cli_parse_int(optarg, 0, VF_EXPORT_MAX_COUNT, &n))
+                return vf_fail(VF_EINPUT, "--count: give a number from 0 to %d",
+                               VF_EXPORT_MAX_COUNT);
+            o->count = (int)n;
         }
     }
     if (optind != argc - 1)
         return vf_fail(VF_EINPUT, "give one workspace folder (see 'vfcapture export --help')");
-    run->ws = argv[optind];
+    *ws = argv[optind];
     return VF_OK;
 }
 
-static vf_status load_inputs(export_run *run, const vf_workspace *ws)
+static double number(const json_t *o, const char *key)
 {
-    char path[VF_PATH_MAX];
-    vf_status status = vf_workspace_path(ws, "attack", "attack.json", path, sizeof path);
-    if (status == VF_OK && !vf_is_file(path))
-        return vf_fail(VF_EINPUT, "%s does not exist: run 'vfcapture attack %s' first", path,
-                       run->ws);
-    if (status == VF_OK)
-        status = vf_attack_file_load(path, &run->attack);
-    if (status == VF_OK)
-        status = vf_workspace_path(ws, "poses", "normalization.json", path, sizeof path);
-    if (status == VF_OK && vf_is_file(path)) {
-        status = vf_normalization_load(path, NULL, &run->colmap_from_object);
-        run->has_colmap = status == VF_OK;
-    } else if (status == VF_OK) {
-        vf_warn("no WS/poses/normalization.json (a posed import): targets in the object frame "
-                "only, no COLMAP frame");
-    }
-    if (status != VF_OK)
-        return status;
-    if (!vf_workspace_metres_per_unit(ws, &run->metres))
-        run->metres = 0;
-    if ((status = vf_workspace_path(ws, "train", "model.vff", path, sizeof path)) == VF_OK &&
-        vf_is_file(path))
-        status = vf_field_load(path, &run->field);
-    else if (status == VF_OK)
-        vf_warn("no trained field (WS/train/model.vff): the shot card has no previews");
-    return status;
+    return json_number_value(json_object_get(o, key));
 }
 
-/* v* first, then the spread samples. */
-static vf_status choose_targets(export_run *run)
+/* "1.20 m" when the export knows the scale, else "3.10 units". */
+static void distance_text(const json_t *words, const char *key, char *out, size_t size)
 {
-    int m = run->count < run->attack.sample_count ? run->count : run->attack.sample_count;
-    if (m < run->count)
-        vf_warn("attack.json has %d samples of p*(v); exporting %d", run->attack.sample_count, m);
-    int *picked = malloc(sizeof(int) * (size_t)(m + 1));
-    run->targets = calloc((size_t)m + 1, sizeof *run->targets);
-    if (!picked || !run->targets) {
-        free(picked);
-        return vf_fail(VF_EINTERNAL, "out of memory");
-    }
-    vf_status status = vf_targets_spread(run->attack.samples, run->attack.sample_count,
-                                         run->attack.range, m, picked);
-    if (status != VF_OK) {
-        free(picked);
-        return status;
-    }
-    run->targets[0] = (target){.v = run->attack.v_star, .kind = "v*", .sample = -1,
-                               .pred = run->attack.v_star_prediction};
-    for (int k = 0; k < m; k++) {
-        target *t = &run->targets[k + 1];
-        t->v = vf_viewpoint_from_array(run->attack.samples + 6 * picked[k]);
-        t->kind = "sample";
-        t->sample = picked[k];
-        if (run->attack.predictions)
-            t->pred = run->attack.predictions[picked[k]];
-        else
-            t->pred.cls = -1;
-    }
-    run->target_count = m + 1;
-    free(picked);
-    for (int i = 0; i < run->target_count; i++) {
-        target *t = &run->targets[i];
-        vf_viewpoint_to_c2w(&t->v, t->c2w);
-        if (run->has_colmap)
-            vf_similarity_apply_c2w(&run->colmap_from_object, t->c2w, t->c2w_colmap);
-        vf_target_describe(t->c2w, &t->words);
-    }
-    return VF_OK;
-}
-
-/* Classify a preview when attack.json does not say what the model predicts there. */
-static vf_status predict_preview(export_run *run, target *t)
-{
-    if (!run->cls) {
-        char path[VF_PATH_MAX];
-        vf_status status = vf_find_model(run->attack.model[0] ? run->attack.model
-                                                              : VF_DEFAULT_MODEL,
-                                         NULL, path, sizeof path);
-        if (status == VF_OK)
-            status = vf_class_names_load();
-        if (status == VF_OK)
-            status = vf_classifier_open(path, &run->cls);
-        if (status != VF_OK)
-            return status;
-    }
-    float *probs = malloc(sizeof(float) * VF_NUM_CLASSES);
-    if (!probs)
-        return vf_fail(VF_EINTERNAL, "out of memory");
-    int size = vf_classifier_input_size(run->cls);
-    vf_status status;
-    if (t->preview.width == size && t->preview.height == size) { /* the classifier's own view */
-        float *chw = malloc(sizeof(float) * 3 * (size_t)size * size);
-        status = chw ? vf_classifier_normalize(&t->preview, chw)
-                     : vf_fail(VF_EINTERNAL, "out of memory");
-        if (status == VF_OK)
-            status = vf_classifier_forward(run->cls, chw, 1, probs);
-        free(chw);
-    } else {
-        status = vf_classifier_classify_images(run->cls, &t->preview, 1, probs);
-    }
-    if (status == VF_OK) {
-        float p;
-        vf_topk(probs, 1, &t->pred.cls, &p);
-        t->pred.confidence = p;
-        t->pred.fooled = !vf_attack_is_label(&run->attack, t->pred.cls);
-        snprintf(t->pred.name, sizeof t->pred.name, "%s", vf_class_short_name(t->pred.cls));
-    }
-    free(probs);
-    return status;
-}
-
-static vf_status render_previews(export_run *run, const char *dir)
-{
-    if (!run->field)
-        return VF_OK;
-    char folder[VF_PATH_MAX], path[VF_PATH_MAX], name[32];
-    vf_camera cam = run->attack.has_camera ? run->attack.camera
-                                           : vf_field_classifier_camera(run->field, PREVIEW_SIZE);
-    vf_status status = vf_path_join(folder, sizeof folder, dir, "previews");
-    if (status == VF_OK)
-        status = vf_mkdirs(folder);
-    for (int i = 0; status == VF_OK && i < run->target_count; i++) {
-        target *t = &run->targets[i];
-        status = vf_field_render(run->field, &cam, t->c2w, &t->preview);
-        snprintf(name, sizeof name, "target_%02d.png", i);
-        if (status == VF_OK)
-            status = vf_path_join(path, sizeof path, folder, name);
-        if (status == VF_OK)
-            status = vf_image_save(path, &t->preview);
-        if (status == VF_OK && t->pred.cls < 0)
-            status = predict_preview(run, t);
-    }
-    return status;
-}
-
-static double to_metres(const export_run *run, double units)
-{
-    return run->metres > 0 ? units * run->metres : NAN;
-}
-
-static json_t *target_json(const export_run *run, int i)
-{
-    const target *t = &run->targets[i];
-    const vf_target_words *w = &t->words;
-    json_t *words = json_pack("{s:f, s:f, s:f, s:f, s:f, s:[f,f,f], s:f}", "azimuth_deg",
-                              w->azimuth_deg, "elevation_deg", w->elevation_deg, "distance",
-                              w->distance, "height", w->height, "roll_deg", w->roll_deg,
-                              "look_at", w->look_at[0], w->look_at[1], w->look_at[2],
-                              "aim_offset", w->aim_offset);
-    if (run->metres > 0) {
-        json_object_set_new(words, "distance_m", json_real(to_metres(run, w->distance)));
-        json_object_set_new(words, "height_m", json_real(to_metres(run, w->height)));
-        json_object_set_new(words, "aim_offset_m", json_real(to_metres(run, w->aim_offset)));
-    }
-    json_t *o = json_pack("{s:i, s:s, s:o, s:o, s:o}", "index", i, "kind", t->kind,
-                          "viewpoint", physical_viewpoint_json(&t->v), "c2w_object",
-                          physical_mat4_json(t->c2w), "words", words);
-    if (run->has_colmap) {
-        double look_colmap[3];
-        vf_similarity_apply(&run->colmap_from_object, w->look_at, look_colmap);
-        json_object_set_new(words, "look_at_colmap",
-                            json_pack("[f,f,f]", look_colmap[0], look_colmap[1], look_colmap[2]));
-        json_object_set_new(o, "c2w_colmap", physical_mat4_json(t->c2w_colmap));
-    }
-    if (t->sample >= 0)
-        json_object_set_new(o, "sample", json_integer(t->sample));
-    if (t->pred.cls >= 0)
-        json_object_set_new(o, "prediction",
-                            json_pack("{s:i, s:s, s:f, s:b}", "class", t->pred.cls, "name",
-                                      t->pred.name, "confidence", t->pred.confidence, "fooled",
-                                      t->pred.fooled));
-    if (t->preview.data) {
-        char name[48];
-        snprintf(name, sizeof name, "previews/target_%02d.png", i);
-        json_object_set_new(o, "preview", json_string(name));
-    }
-    return o;
-}
-
-static void distance_text(const export_run *run, double units, char *out, size_t size)
-{
-    if (run->metres > 0)
-        snprintf(out, size, "%.2f m", to_metres(run, units));
+    char metres[32];
+    snprintf(metres, sizeof metres, "%s_m", key);
+    if (json_object_get(words, metres))
+        snprintf(out, size, "%.2f m", number(words, metres));
     else
-        snprintf(out, size, "%.2f units", units);
+        snprintf(out, size, "%.2f units", number(words, key));
 }
 
-static void fill_tile(const export_run *run, int i, shot_tile *tile)
+static void print_targets(const char *ws, const json_t *doc)
 {
-    const target *t = &run->targets[i];
-    const vf_target_words *w = &t->words;
-    char d[32], h[32];
-    memset(tile, 0, sizeof *tile);
-    tile->preview = t->preview.data ? &t->preview : NULL;
-    snprintf(tile->title, sizeof tile->title, "target %d: %s", i,
-             t->sample < 0 ? "v* (strongest)" : "sample of p*(v)");
-    distance_text(run, w->distance, d, sizeof d);
-    distance_text(run, w->height, h, sizeof h);
-    snprintf(tile->lines[0], sizeof tile->lines[0], "azimuth %.0f deg, elevation %.0f deg",
-             w->azimuth_deg, w->elevation_deg);
-    snprintf(tile->lines[1], sizeof tile->lines[1], "distance %s, height %s", d, h);
-    snprintf(tile->lines[2], sizeof tile->lines[2], "roll %.0f deg, aim %.2f off centre",
-             w->roll_deg, w->aim_offset);
-    snprintf(tile->lines[3], sizeof tile->lines[3], "v = (%.0f, %.0f, %.0f, %.2f, %.2f, %.2f)",
-             t->v.psi, t->v.theta, t->v.phi, t->v.dx, t->v.dy, t->v.dz);
-    if (t->pred.cls >= 0)
-        snprintf(tile->lines[4], sizeof tile->lines[4], "predicted: %.40s (%.0f%%)%s",
-                 t->pred.name, 100 * t->pred.confidence, t->pred.fooled ? " - fooled" : "");
-    else
-        snprintf(tile->lines[4], sizeof tile->lines[4], "predicted: unknown");
-}
-
-static vf_status write_csv(const export_run *run, const char *path)
-{
-    char *text = NULL;
-    size_t size = 0;
-    FILE *f = open_memstream(&text, &size);
-    if (!f)
-        return vf_fail(VF_EINTERNAL, "out of memory");
-    fprintf(f, "index,kind,psi,theta,phi,dx,dy,dz,azimuth_deg,elevation_deg,distance,height,"
-               "roll_deg,look_x,look_y,look_z,distance_m,predicted_class,predicted_name,fooled,"
-               "colmap_cam_x,colmap_cam_y,colmap_cam_z\n");
-    for (int i = 0; i < run->target_count; i++) {
-        const target *t = &run->targets[i];
-        const vf_target_words *w = &t->words;
-        fprintf(f, "%d,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.4f,%.4f,%.6g,%.6g,%.4f,%.6g,%.6g,%.6g,",
-                i, t->kind, t->v.psi, t->v.theta, t->v.phi, t->v.dx, t->v.dy, t->v.dz,
-                w->azimuth_deg, w->elevation_deg, w->distance, w->height, w->roll_deg,
-                w->look_at[0], w->look_at[1], w->look_at[2]);
-        if (run->metres > 0)
-            fprintf(f, "%.6g", to_metres(run, w->distance));
-        if (t->pred.cls >= 0)
-            fprintf(f, ",%d,\"%s\",%d", t->pred.cls, t->pred.name, t->pred.fooled);
-        else
-            fprintf(f, ",,,");
-        if (run->has_colmap)
-            fprintf(f, ",%.9g,%.9g,%.9g\n", t->c2w_colmap[3], t->c2w_colmap[7],
-                    t->c2w_colmap[11]);
-        else
-            fprintf(f, ",,,\n");
-    }
-    fclose(f);
-    vf_status status = vf_write_file_atomic(path, text, size);
-    free(text);
-    return status;
-}
-
-static vf_status write_outputs(export_run *run, const char *dir, json_t **summary)
-{
-    char path[VF_PATH_MAX];
-    vf_status status = render_previews(run, dir);
-    json_t *list = json_array();
-    for (int i = 0; i < run->target_count; i++)
-        json_array_append_new(list, target_json(run, i));
-    json_t *doc = json_pack("{s:s, s:s, s:o, s:o}", "convention",
-                            "c2w: camera-to-world, row-major 4x4, OpenGL camera axes (x right, y "
-                            "up, looking along -z); object frame z up, object at the origin; "
-                            "azimuth about +z from -y, counterclockwise seen from above",
-                            "units", run->metres > 0 ? "scene units and metres" : "scene units",
-                            "metres_per_unit",
-                            run->metres > 0 ? json_real(run->metres) : json_null(), "targets",
-                            list);
-    if (status == VF_OK && (status = vf_path_join(path, sizeof path, dir, "targets.json")) == VF_OK)
-        status = vf_json_save(path, doc);
-    if (status == VF_OK && (status = vf_path_join(path, sizeof path, dir, "targets.csv")) == VF_OK)
-        status = write_csv(run, path);
-    shot_tile *tiles = calloc((size_t)run->target_count, sizeof *tiles);
-    if (status == VF_OK && !tiles)
-        status = vf_fail(VF_EINTERNAL, "out of memory");
-    for (int i = 0; status == VF_OK && i < run->target_count; i++)
-        fill_tile(run, i, &tiles[i]);
-    char heading[256];
-    snprintf(heading, sizeof heading, "vfcapture targets for %.100s (true label: %.100s)",
-             run->ws, run->attack.label_text);
-    if (status == VF_OK && (status = vf_path_join(path, sizeof path, dir, "shot_card.png")) == VF_OK)
-        status = shot_card_save(path, heading, tiles, run->target_count);
-    free(tiles);
-    if (status == VF_OK)
-        *summary = json_pack("{s:i, s:b, s:b}", "targets", run->target_count, "previews",
-                             run->field != NULL, "metric", run->metres > 0);
-    json_decref(doc);
-    return status;
-}
-
-static void print_targets(const export_run *run)
-{
-    for (int i = 0; i < run->target_count; i++) {
-        const target *t = &run->targets[i];
+    size_t i;
+    const json_t *t;
+    json_array_foreach(json_object_get(doc, "targets"), i, t)
+    {
+        const json_t *w = json_object_get(t, "words");
+        const char *predicted =
+            json_string_value(json_object_get(json_object_get(t, "prediction"), "name"));
         char d[32], h[32];
-        distance_text(run, t->words.distance, d, sizeof d);
-        distance_text(run, t->words.height, h, sizeof h);
-        printf("target %d (%s): azimuth %.0f deg, elevation %.0f deg, distance %s, height %s, "
+        distance_text(w, "distance", d, sizeof d);
+        distance_text(w, "height", h, sizeof h);
+        printf("target %zu (%s): azimuth %.0f deg, elevation %.0f deg, distance %s, height %s, "
                "roll %.0f deg%s%s\n",
-               i, t->kind, t->words.azimuth_deg, t->words.elevation_deg, d, h, t->words.roll_deg,
-               t->pred.cls >= 0 ? "; predicted " : "", t->pred.cls >= 0 ? t->pred.name : "");
+               i, json_string_value(json_object_get(t, "kind")), number(w, "azimuth_deg"),
+               number(w, "elevation_deg"), d, h, number(w, "roll_deg"),
+               predicted ? "; predicted " : "", predicted ? predicted : "");
     }
-    printf("targets in %s/export/ (targets.json, targets.csv, shot_card.png)\n", run->ws);
-}
-
-static void export_free(export_run *run)
-{
-    for (int i = 0; run->targets && i < run->target_count; i++)
-        vf_image_free(&run->targets[i].preview);
-    free(run->targets);
-    vf_attack_file_free(&run->attack);
-    vf_field_free(run->field);
-    vf_classifier_close(run->cls);
+    printf("targets in %s/export/ (targets.json, targets.csv, shot_card.png)\n", ws);
 }
 
 int cmd_export(int argc, char **argv)
 {
-    export_run run = {0};
+    const char *root = NULL;
+    vf_export_options o;
+    vf_export_defaults(&o);
     cli_flags flags = {0};
     vf_workspace ws;
-    json_t *summary = NULL;
-    vf_status status = parse(argc, argv, &run, &flags);
-    if (status == VF_OK)
-        status = vf_workspace_open(run.ws, 0, &ws);
-    if (status != VF_OK)
-        return cli_fail("export", status);
-    vf_stage stage;
-    if ((status = load_inputs(&run, &ws)) == VF_OK && (status = choose_targets(&run)) == VF_OK &&
-        (status = vf_stage_begin(&ws, "export", &stage)) == VF_OK) {
-        status = write_outputs(&run, stage.dir, &summary);
-        if (status == VF_OK)
-            status = vf_stage_commit(&stage, json_pack("{s:i}", "count", run.count),
-                                     json_deep_copy(summary));
-        else
-            vf_stage_abort(&stage);
+    json_t *doc = NULL;
+    vf_status s = parse(argc, argv, &root, &o, &flags);
+    if (s == VF_OK && (s = vf_workspace_open(root, 0, &ws)) == VF_OK) {
+        s = vf_export_run(&ws, &o, &doc);
+        vf_workspace_close(&ws);
     }
-    if (status == VF_OK && !flags.json)
-        print_targets(&run);
-    if (status == VF_OK && flags.json) {
-        char path[VF_PATH_MAX];
-        json_t *doc = NULL;
-        if (vf_workspace_path(&ws, "export", "targets.json", path, sizeof path) == VF_OK &&
-            vf_json_load(path, &doc) == VF_OK)
-            cli_print_json(doc);
+    if (s != VF_OK)
+        return cli_fail("export", s);
+    if (flags.json)
+        cli_print_json(doc);
+    else {
+        print_targets(root, doc);
+        json_decref(doc);
     }
-    json_decref(summary);
-    export_free(&run);
-    vf_workspace_close(&ws);
-    return status == VF_OK ? 0 : cli_fail("export", status);
+    return 0;
 }

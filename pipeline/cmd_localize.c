@@ -4,8 +4,8 @@
 #include <string.h>
 
 #include "cli.h"
-#include "frames_in.h"
 #include "physical.h"
+#include "vf/frames.h"
 #include "vf/log.h"
 
 static const char usage[] =
@@ -39,7 +39,7 @@ static vf_status parse(int argc, char **argv, vf_localize_options *lo, cli_flags
     return VF_OK;
 }
 
-static void print_frame(const frame_info *info, const vf_localize_result *r)
+static void print_frame(const vf_frame_info *info, const vf_localize_result *r)
 {
     if (!r->localized) {
         printf("%s: %s\n", info->name, r->reason);
@@ -55,15 +55,15 @@ static void print_frame(const frame_info *info, const vf_localize_result *r)
                m[4 * row + 3]);
 }
 
-static vf_status localize_all(vf_localizer *loc, frames_in *in, const cli_flags *flags,
+static vf_status localize_all(vf_localizer *loc, vf_frames *in, const cli_flags *flags,
                               json_t *frames, int *total, int *localized, double *seconds)
 {
     vf_rgb8 frame = {0};
-    frame_info info;
+    vf_frame_info info;
     int got;
     vf_status status;
     double busy = 0;
-    while ((status = frames_in_next(in, &frame, &info, &got)) == VF_OK && got) {
+    while ((status = vf_frames_next(in, &frame, &info, &got)) == VF_OK && got) {
         vf_localize_result r;
         if ((status = vf_localize_frame(loc, &frame, &r)) != VF_OK) {
             vf_error_prefix("%s", info.name);
@@ -73,7 +73,7 @@ static vf_status localize_all(vf_localizer *loc, frames_in *in, const cli_flags 
         (*total)++;
         *localized += r.localized;
         if (flags->json) {
-            json_t *o = physical_result_json(&r);
+            json_t *o = vf_localize_result_json(&r);
             json_object_set_new(o, "frame", json_string(info.name));
             json_array_append_new(frames, o);
         } else {
@@ -95,11 +95,11 @@ int cmd_localize(int argc, char **argv)
         return cli_fail("localize", status);
     const char *ws = argv[optind];
     vf_localizer *loc = NULL;
-    frames_in in = {0};
+    vf_frames in = {0};
     json_t *frames = json_array();
     int localized = 0, total = 0;
     double seconds = 0;
-    status = frames_in_open(argv + optind + 1, argc - optind - 1, &in);
+    status = vf_frames_open(argv + optind + 1, argc - optind - 1, &in);
     if (status == VF_OK)
         status = vf_localizer_open(ws, &lo, &loc);
     if (status == VF_OK) {
@@ -109,7 +109,7 @@ int cmd_localize(int argc, char **argv)
         status = localize_all(loc, &in, &flags, frames, &total, &localized, &seconds);
     }
     vf_localizer_close(loc);
-    frames_in_close(&in);
+    vf_frames_close(&in);
     if (status != VF_OK) {
         json_decref(frames);
         return cli_fail("localize", status);

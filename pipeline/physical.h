@@ -1,6 +1,6 @@
-/* pipeline/physical.h: what the physical-loop commands share (localize, export, reshoot,
- * score): the localization options on the command line, a localization result as JSON and
- * as a line of text, and the viewpoint tolerance box. Private to the pipeline. */
+/* pipeline/physical.h: what the physical-loop commands share (localize, reshoot, score): the
+ * localization options on the command line and a viewpoint as a line of text. Private to the
+ * pipeline. */
 #ifndef VF_PIPELINE_PHYSICAL_H
 #define VF_PIPELINE_PHYSICAL_H
 
@@ -39,22 +39,7 @@ enum {
 vf_status physical_localize_option(int opt, const char *arg, vf_localize_options *lo,
                                    int *handled);
 
-/* The viewpoint (and, c2w not NULL, the object-frame camera-to-world) of exported target n
- * of WS/export/targets.json. VF_EINPUT when there is no export or no such target. */
-vf_status physical_load_target(const char *ws, int n, vf_viewpoint *v, double c2w[16]);
-
-/* {"localized":..., "reason" or the pose, the viewpoint, inliers, ...} for one frame. */
-json_t *physical_result_json(const vf_localize_result *r);
-json_t *physical_viewpoint_json(const vf_viewpoint *v);
-json_t *physical_mat4_json(const double m[16]);
-
 /* "psi 12.3 theta -4.0 phi 101.2 dx 0.02 dy -0.31 dz 0.05" */
 void physical_viewpoint_text(const vf_viewpoint *v, char *out, size_t size);
-
-/* Whether viewpoint v lies within +-tolerance (a share, 0.05 for 5%) of each parameter's
- * measurement range (vf_attack_file.range) around `center`; psi differences wrap around 360
- * degrees. *worst (may be NULL) receives the largest |difference| / range. */
-int physical_within_box(const vf_viewpoint *v, const vf_viewpoint *center, const double range[6],
-                        double tolerance, double *worst);
 
 #endif

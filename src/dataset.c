@@ -179,15 +179,6 @@ vf_status vf_dataset_load(const char *transforms_path, vf_dataset *out)
     return status;
 }
 
-static json_t *matrix_json(const double m[16])
-{
-    json_t *rows = json_array();
-    for (int r = 0; r < 4; r++)
-        json_array_append_new(rows, json_pack("[f,f,f,f]", m[4 * r], m[4 * r + 1], m[4 * r + 2],
-                                              m[4 * r + 3]));
-    return rows;
-}
-
 static void write_intrinsics(json_t *obj, const vf_camera *c)
 {
     json_object_set_new(obj, "camera_angle_x", json_real(2.0 * atan(0.5 * c->width / c->fx)));
@@ -221,8 +212,8 @@ vf_status vf_dataset_save(const char *transforms_path, const vf_dataset *ds)
         const char *path = f->image_path;
         if (!strncmp(path, base_dir, base_len) && path[base_len] == '/')
             path += base_len + 1;
-        json_t *frame = json_pack("{s:s, s:o}", "file_path", path, "transform_matrix",
-                                  matrix_json(f->c2w));
+        json_t *frame =
+            json_pack("{s:s, s:o}", "file_path", path, "transform_matrix", vf_json_mat4(f->c2w));
         if (!shared)
             write_intrinsics(frame, &f->camera);
         json_array_append_new(frames, frame);

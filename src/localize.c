@@ -13,6 +13,7 @@
 #include "vf/colmap_model.h"
 #include "vf/fsutil.h"
 #include "vf/log.h"
+#include "vf/targets.h"
 #include "vf/workspace.h"
 
 struct vf_localizer {
@@ -391,4 +392,20 @@ vf_status vf_localize_frame(vf_localizer *loc, const vf_rgb8 *frame, vf_localize
     vf_rgb8_free(&small);
     result->seconds = vf_now() - start;
     return status;
+}
+
+json_t *vf_localize_result_json(const vf_localize_result *r)
+{
+    json_t *o =
+        json_pack("{s:b, s:i, s:i, s:i, s:f, s:f, s:f}", "localized", r->localized, "features",
+                  r->features, "matches", r->matches, "inliers", r->inliers, "inlier_ratio",
+                  r->inlier_ratio, "reprojection_px", r->reprojection_px, "seconds", r->seconds);
+    if (!r->localized) {
+        json_object_set_new(o, "reason", json_string(r->reason));
+        return o;
+    }
+    json_object_set_new(o, "viewpoint", vf_viewpoint_json(&r->viewpoint));
+    json_object_set_new(o, "c2w_object", vf_json_mat4(r->c2w_object));
+    json_object_set_new(o, "c2w_colmap", vf_json_mat4(r->c2w_colmap));
+    return o;
 }

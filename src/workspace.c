@@ -44,6 +44,14 @@ json_t *vf_json_doubles(const double *x, int n)
     return a;
 }
 
+json_t *vf_json_mat4(const double m[16])
+{
+    json_t *rows = json_array();
+    for (int r = 0; r < 4; r++)
+        json_array_append_new(rows, vf_json_doubles(m + 4 * r, 4));
+    return rows;
+}
+
 int vf_json_read_doubles(const json_t *array, double *out, int n)
 {
     if (!json_is_array(array) || json_array_size(array) != (size_t)n)

@@ -23,7 +23,7 @@ expect 1 "localize: bad --min-inliers" -- "$tool" localize "$tmp/ws" "$fox" --mi
 one_line_naming "localize: bad --min-inliers" "min-inliers"
 
 expect 1 "export without an attack" -- "$tool" export "$tmp/ws"
-one_line_naming "export without an attack" "attack.json does not exist"
+one_line_naming "export without an attack" "has no attack yet: run 'vfcapture attack"
 expect 1 "export: bad --count" -- "$tool" export "$tmp/ws" --count -3
 one_line_naming "export: bad --count" "count"
 [ ! -e "$tmp/ws/export" ] && ok || bad "a failed export writes nothing"
@@ -34,10 +34,10 @@ expect 1 "reshoot with two sources" -- "$tool" reshoot "$tmp/ws" --target 0 --vi
 one_line_naming "reshoot with two sources" "one source"
 
 expect 1 "score without an attack" -- "$tool" score "$tmp/ws" "$fox"
-one_line_naming "score without an attack" "attack.json does not exist"
+one_line_naming "score without an attack" "has no attack yet"
 expect 1 "score: bad --tolerance" -- "$tool" score "$tmp/ws" "$fox" --tolerance 0
 one_line_naming "score: bad --tolerance" "tolerance"
 expect 1 "score --summary without a score" -- "$tool" score --summary "$tmp/ws"
-one_line_naming "score --summary without a score" "attack.json"
+one_line_naming "score --summary without a score" "vfcapture attack"
 [ ! -e "$tmp/ws/score" ] && ok || bad "a failed score writes nothing"
 cli_finish

@@ -26,6 +26,7 @@
 #include "vf/resources.h"
 #include "vf/video.h"
 #include "vf/wilson.h"
+#include "vf/workspace.h"
 
 #define FOX "data/real_captures/instant_ngp_fox"
 #define HELD_OUT_EVERY 5   /* photos 4, 9, 14, ... (name order) are left out */
@@ -281,11 +282,16 @@ static void write_attack(const char *ws, const vf_dataset *ours, vf_viewpoint *v
         v_star->phi, v_star->dx, v_star->dy, v_star->dz, "samples", samples,
         "sample_predictions", preds, "natural_accuracy", 0.9, "asr_v_star", 1.0, "asr_samples",
         0.5);
+    /* committed as the attack stage, as `vfcapture attack` leaves it */
     char path[2 * VF_PATH_MAX];
-    snprintf(path, sizeof path, "%s/attack", ws);
-    vf_mkdirs(path);
-    snprintf(path, sizeof path, "%s/attack/attack.json", ws);
-    CHECK(vf_json_save(path, doc) == VF_OK, "wrote %s", path);
+    vf_workspace w;
+    vf_stage stage;
+    CHECK(vf_workspace_open(ws, 0, &w) == VF_OK && vf_stage_begin(&w, "attack", &stage) == VF_OK,
+          "attack stage begun: %s", vf_error_message());
+    snprintf(path, sizeof path, "%s/attack.json", stage.dir);
+    CHECK(vf_json_save(path, doc) == VF_OK && vf_stage_commit(&stage, NULL, NULL) == VF_OK,
+          "wrote %s", path);
+    vf_workspace_close(&w);
     json_decref(doc);
 }
 

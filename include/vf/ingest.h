@@ -1,4 +1,12 @@
-/* vf/ingest.h: from a capture to the frames later stages work on.
+/* vf/ingest.h: from a capture to the frames later stages work on; the ingest stage.
+ *
+ * The stage (vf_ingest_run) takes one input into WS/ingest/ through a staging folder: a
+ * capture (below), a posed set (a NeRF transforms.json: every image decoded once to check
+ * it, copied into WS/ingest/images/ and listed with its camera in WS/ingest/transforms.json,
+ * so later stages never depend on the original folder) or a 3D model (rendered by Blender
+ * into a posed set, the paper's capture, vf/object3d.h). A workspace the stage created is
+ * removed again when it fails; an existing one keeps its earlier output. A model's renders
+ * that stop half-way (interrupted, not refused) stay in the staging folder for the next run.
  *
  * Three sources, one result. A video file, a folder of photos or a V4L2 webcam is read, every
  * frame is scored for sharpness, the frames to keep are chosen (vf/frame_select.h), shrunk to
@@ -18,6 +26,7 @@
 
 #include "vf/error.h"
 #include "vf/frame_select.h"
+#include "vf/object3d.h"
 #include "vf/v4l2.h"
 
 #ifdef __cplusplus
@@ -64,6 +73,38 @@ vf_status vf_ingest_photos(const char *folder, const vf_ingest_options *options,
  * far, then choose among them. */
 vf_status vf_ingest_camera(const char *device, const vf_ingest_options *options,
                            const char *out_dir, json_t **report);
+
+/* ---- the stage ---- */
+
+typedef enum {
+    VF_INGEST_VIDEO = 0,
+    VF_INGEST_PHOTOS = 1,
+    VF_INGEST_CAMERA = 2,     /* a V4L2 device */
+    VF_INGEST_TRANSFORMS = 3, /* a posed set */
+    VF_INGEST_MODEL = 4       /* a 3D model (vf_object3d_is_model) */
+} vf_ingest_kind;
+
+/* "video", "photos", "camera", "transforms", "model". */
+const char *vf_ingest_kind_name(vf_ingest_kind kind);
+
+/* What an input path is: a folder is photos, a .json file a posed set, a model file a 3D
+ * model, any other file a video. VF_EINPUT when the path does not exist. */
+vf_status vf_ingest_input_kind(const char *path, vf_ingest_kind *kind);
+
+typedef struct vf_ingest_request {
+    vf_ingest_kind kind;
+    const char *input;         /* the file, folder or device */
+    vf_ingest_options capture; /* video, photos, camera */
+    vf_object3d_capture model; /* a 3D model */
+} vf_ingest_request;
+
+/* Zero input, the defaults of both option sets. */
+void vf_ingest_request_defaults(vf_ingest_request *r);
+
+/* Run the stage into the workspace at ws_root (created when missing). *summary gets the
+ * manifest's summary of the stage (a new reference): frames, size, and per kind what was
+ * kept and why (captures), the background (posed sets), or views and seconds (models). */
+vf_status vf_ingest_run(const char *ws_root, const vf_ingest_request *r, json_t **summary);
 
 #ifdef __cplusplus
 }

@@ -24,6 +24,8 @@
 #ifndef VF_LOCALIZE_H
 #define VF_LOCALIZE_H
 
+#include <jansson.h>
+
 #include "vf/camera.h"
 #include "vf/error.h"
 #include "vf/pose.h"
@@ -77,6 +79,11 @@ void vf_localizer_map_size(const vf_localizer *loc, int *points, int *descriptor
  * and the reason; errors are for frames that cannot be used at all (a size whose aspect ratio
  * does not fit the camera) or internal failures. */
 vf_status vf_localize_frame(vf_localizer *loc, const vf_rgb8 *frame, vf_localize_result *result);
+
+/* {"localized", "features", "matches", "inliers", "inlier_ratio", "reprojection_px",
+ * "seconds"} and either "reason" or "viewpoint", "c2w_object", "c2w_colmap" (a new
+ * reference). */
+json_t *vf_localize_result_json(const vf_localize_result *r);
 
 /* ---- normalization.json ---- */
 

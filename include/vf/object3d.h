@@ -116,6 +116,16 @@ void vf_real_defaults(vf_real_options *o);
  * folder are kept. *result (may be NULL) gets real.json's document (a new reference). */
 vf_status vf_real_run(vf_workspace *ws, const vf_real_options *o, json_t **result);
 
+#define VF_REAL_FILE "real.json" /* in WS/real/ */
+
+/* The object's side of real.json: natural accuracy, Real(v*), Real(p*(v)). */
+typedef struct vf_real_rates {
+    double natural_accuracy, asr_v_star, asr_samples;
+} vf_real_rates;
+
+/* Read those rates from WS/real/real.json; *found = 0 (and VF_OK) when the stage has not run. */
+vf_status vf_real_load_rates(const vf_workspace *ws, vf_real_rates *out, int *found);
+
 #ifdef __cplusplus
 }
 #endif

@@ -17,6 +17,8 @@
 #ifndef VF_TARGETS_H
 #define VF_TARGETS_H
 
+#include <jansson.h>
+
 #include "vf/error.h"
 #include "vf/fsutil.h"
 #include "vf/pose.h"
@@ -30,6 +32,19 @@ extern "C" {
 /* The viewpoint of target n (from 0) of an export's targets.json. VF_EINPUT naming the file
  * when there is no such target or its six numbers are not finite and in range. */
 vf_status vf_targets_file_target(const char *path, int n, vf_viewpoint *v);
+
+/* Target n of WS/export/targets.json of the workspace at ws_root, and (c2w not NULL) its
+ * object-frame camera-to-world. VF_EINPUT saying to run export first when there is none. */
+vf_status vf_targets_workspace_target(const char *ws_root, int n, vf_viewpoint *v, double c2w[16]);
+
+/* [psi, theta, phi, dx, dy, dz] (a new reference). */
+json_t *vf_viewpoint_json(const vf_viewpoint *v);
+
+/* Whether viewpoint v lies within +-tolerance (a share, 0.05 for 5%) of each parameter's
+ * measurement range (vf_attack_file.range) around `center`; psi differences wrap around 360
+ * degrees. *worst (may be NULL) receives the largest |difference| / range. */
+int vf_viewpoint_within(const vf_viewpoint *v, const vf_viewpoint *center, const double range[6],
+                        double tolerance, double *worst);
 
 /* ---- viewpoints in words ---- */
 

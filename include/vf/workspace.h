@@ -69,6 +69,8 @@ vf_status vf_json_save(const char *path, const json_t *doc);
 vf_status vf_json_load(const char *path, json_t **out);
 /* n numbers as a JSON array (a new reference). */
 json_t *vf_json_doubles(const double *x, int n);
+/* A 4x4 row-major matrix as four rows of four numbers (a new reference). */
+json_t *vf_json_mat4(const double m[16]);
 /* An array of exactly n finite numbers into out: 1, else 0 (out partly written). */
 int vf_json_read_doubles(const json_t *array, double *out, int n);
 

@@ -319,7 +319,7 @@ static vf_status save_curve(const real_run *r, const char *path)
 static vf_status save_outputs(const real_run *r, json_t *doc)
 {
     char path[VF_PATH_MAX];
-    vf_status s = vf_path_join(path, sizeof path, r->stage.dir, "real.json");
+    vf_status s = vf_path_join(path, sizeof path, r->stage.dir, VF_REAL_FILE);
     if (s == VF_OK)
         s = vf_json_save(path, doc);
     if (s == VF_OK && (s = vf_path_join(path, sizeof path, r->stage.dir, "sheet.png")) == VF_OK)
@@ -380,5 +380,31 @@ vf_status vf_real_run(vf_workspace *ws, const vf_real_options *o, json_t **resul
     }
     json_decref(doc);
     release(&r);
+    return s;
+}
+
+vf_status vf_real_load_rates(const vf_workspace *ws, vf_real_rates *out, int *found)
+{
+    char path[VF_PATH_MAX];
+    json_t *doc = NULL;
+    *found = 0;
+    if (!vf_workspace_has_stage(ws, "real"))
+        return VF_OK;
+    vf_status s = vf_workspace_path(ws, "real", VF_REAL_FILE, path, sizeof path);
+    if (s == VF_OK)
+        s = vf_json_load(path, &doc);
+    if (s != VF_OK)
+        return s;
+    const char *keys[3] = {"natural_accuracy", "asr_v_star", "asr_samples"};
+    double *dst[3] = {&out->natural_accuracy, &out->asr_v_star, &out->asr_samples};
+    for (int i = 0; i < 3 && s == VF_OK; i++) {
+        const json_t *x = json_object_get(json_object_get(doc, keys[i]), "real");
+        if (!json_is_number(x))
+            s = vf_fail(VF_EINPUT, "%s: no \"%s\" of the object (\"real\")", path, keys[i]);
+        else
+            *dst[i] = json_number_value(x);
+    }
+    json_decref(doc);
+    *found = s == VF_OK;
     return s;
 }

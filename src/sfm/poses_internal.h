@@ -1,35 +1,22 @@
-/* pipeline/poses.h: the poses stage's pieces, shared by cmd_poses.c (options, the flow, the
- * outputs) and poses_colmap.c (the COLMAP steps). Private to the pipeline. */
-#ifndef VF_PIPELINE_POSES_H
-#define VF_PIPELINE_POSES_H
+/* src/sfm/poses_internal.h: the poses stage's pieces, shared by poses.c (the flow, the
+ * outputs) and poses_colmap.c (the COLMAP steps). Not installed. */
+#ifndef VF_SFM_POSES_INTERNAL_H
+#define VF_SFM_POSES_INTERNAL_H
 
 #include <jansson.h>
 
 #include "vf/camera.h"
 #include "vf/colmap.h"
 #include "vf/colmap_model.h"
+#include "vf/poses.h"
 #include "vf/sfm_images.h"
 #include "vf/workspace.h"
 
 #define RETRIEVAL_IMAGES 40 /* retrieval matching: each frame with this many most similar */
 
-typedef struct poses_options {
-    const char *workspace;
-    const char *matcher;      /* "auto", "sequential", "exhaustive", "retrieval" */
-    const char *camera_model; /* "auto" or a COLMAP model name */
-    const char *vocab_tree;   /* a tree for loop detection and retrieval, or NULL: build one */
-    int overlap;              /* sequential matching: neighbours per frame */
-    int max_features;
-    double min_registered;    /* share of frames that must register */
-    int undistort;
-    int has_intrinsics;       /* known camera: `known` holds it (size of the frames) */
-    vf_camera known;
-    const char *camera_file;  /* where `known` came from, or NULL for --intrinsics */
-} poses_options;
-
 /* One run of the stage: everything the steps share. */
 typedef struct poses_run {
-    const poses_options *opt;
+    vf_poses_options *opt; /* the caller's, with the known camera fitted */
     vf_stage stage;
     vf_colmap colmap;
     char scratch[VF_PATH_MAX];  /* stage/.colmap: COLMAP's working files, dropped at the end */
@@ -45,12 +32,12 @@ typedef struct poses_run {
 } poses_run;
 
 /* COLMAP steps (poses_colmap.c); each adds its wall time to run->seconds. */
-vf_status poses_extract_features(poses_run *run);
-vf_status poses_match(poses_run *run);
+vf_status vf__poses_extract_features(poses_run *run);
+vf_status vf__poses_match(poses_run *run);
 /* Map, convert every model COLMAP made to text, keep the largest in run->model and its text
  * files in stage/sparse. No model at all leaves run->model empty (0 images). */
-vf_status poses_map(poses_run *run);
+vf_status vf__poses_map(poses_run *run);
 /* Undistorted pinhole images in stage/undistorted/images and their cameras in `out`. */
-vf_status poses_undistort(poses_run *run, vf_colmap_model *out);
+vf_status vf__poses_undistort(poses_run *run, vf_colmap_model *out);
 
 #endif

@@ -76,7 +76,8 @@ static void draw_tile(cairo_t *cr, const shot_tile *t, double x0, double y0)
     }
 }
 
-vf_status shot_card_save(const char *path, const char *heading, const shot_tile *tiles, int count)
+vf_status vf__shot_card_save(const char *path, const char *heading, const shot_tile *tiles,
+                             int count)
 {
     int cols = count < COLUMNS ? (count > 0 ? count : 1) : COLUMNS;
     int rows = (count + COLUMNS - 1) / COLUMNS;

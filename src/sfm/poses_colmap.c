@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "poses.h"
+#include "poses_internal.h"
 #include "vf/log.h"
 
 /* Run one COLMAP command and record its wall time under its name (summed over repeats). */
@@ -32,7 +32,7 @@ static void known_params(const vf_camera *c, char *out, size_t size)
                  c->p2);
 }
 
-vf_status poses_extract_features(poses_run *run)
+vf_status vf__poses_extract_features(poses_run *run)
 {
     vf_args a = {0};
     vf_args_add(&a, "feature_extractor");
@@ -74,7 +74,7 @@ static vf_status build_vocab_tree(poses_run *run, char *path, size_t size)
     return run_step(run, "COLMAP: building a vocabulary tree", &a);
 }
 
-vf_status poses_match(poses_run *run)
+vf_status vf__poses_match(poses_run *run)
 {
     int sequential = !strcmp(run->matcher, "sequential");
     int retrieval = !strcmp(run->matcher, "retrieval");
@@ -198,7 +198,7 @@ static vf_status keep_model_text(poses_run *run)
     return status;
 }
 
-vf_status poses_map(poses_run *run)
+vf_status vf__poses_map(poses_run *run)
 {
     char sparse[VF_PATH_MAX];
     vf_status status = vf_path_join(sparse, sizeof sparse, run->scratch, "sparse");
@@ -295,7 +295,7 @@ static vf_status restore_alpha(poses_run *run, const vf_colmap_model *undistorte
     return status;
 }
 
-vf_status poses_undistort(poses_run *run, vf_colmap_model *out)
+vf_status vf__poses_undistort(poses_run *run, vf_colmap_model *out)
 {
     char out_dir[VF_PATH_MAX], sparse[VF_PATH_MAX], txt[VF_PATH_MAX];
     vf_status status = vf_path_join(out_dir, sizeof out_dir, run->stage.dir, "undistorted");

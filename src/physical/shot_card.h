@@ -1,8 +1,8 @@
-/* pipeline/shot_card.h: the export's shot card, one PNG a person takes to the object: a tile
- * per target with its preview render and the numbers to act on. Drawn with cairo. Private
- * to the pipeline; inputs are borrowed. */
-#ifndef VF_PIPELINE_SHOT_CARD_H
-#define VF_PIPELINE_SHOT_CARD_H
+/* src/physical/shot_card.h: the export's shot card, one PNG a person takes to the object: a tile
+ * per target with its preview render and the numbers to act on. Drawn with cairo. Internal
+ * to the export stage; inputs are borrowed. */
+#ifndef VF_PHYSICAL_SHOT_CARD_H
+#define VF_PHYSICAL_SHOT_CARD_H
 
 #include "vf/error.h"
 #include "vf/image.h"
@@ -16,6 +16,7 @@ typedef struct shot_tile {
 } shot_tile;
 
 /* Draw `count` tiles in a grid (4 per row) under a heading and save to path (PNG). */
-vf_status shot_card_save(const char *path, const char *heading, const shot_tile *tiles, int count);
+vf_status vf__shot_card_save(const char *path, const char *heading, const shot_tile *tiles,
+                             int count);
 
 #endif

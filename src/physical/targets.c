@@ -33,6 +33,43 @@ vf_status vf_targets_file_target(const char *path, int n, vf_viewpoint *v)
     return VF_OK;
 }
 
+vf_status vf_targets_workspace_target(const char *ws_root, int n, vf_viewpoint *v, double c2w[16])
+{
+    char path[VF_PATH_MAX];
+    vf_status status = vf_path_join(path, sizeof path, ws_root, "export/targets.json");
+    if (status == VF_OK && !vf_is_file(path))
+        return vf_fail(VF_EINPUT, "%s does not exist: run 'vfcapture export %s' first", path,
+                       ws_root);
+    if (status == VF_OK)
+        status = vf_targets_file_target(path, n, v);
+    if (status == VF_OK && c2w)
+        vf_viewpoint_to_c2w(v, c2w);
+    return status;
+}
+
+json_t *vf_viewpoint_json(const vf_viewpoint *v)
+{
+    return json_pack("[f,f,f,f,f,f]", v->psi, v->theta, v->phi, v->dx, v->dy, v->dz);
+}
+
+int vf_viewpoint_within(const vf_viewpoint *v, const vf_viewpoint *center, const double range[6],
+                        double tolerance, double *worst)
+{
+    double a[6], c[6], largest = 0;
+    vf_viewpoint_to_array(v, a);
+    vf_viewpoint_to_array(center, c);
+    for (int i = 0; i < 6; i++) {
+        double d = a[i] - c[i];
+        if (i == 0)
+            d = remainder(d, 360.0);
+        double share = fabs(d) / range[i];
+        largest = share > largest ? share : largest;
+    }
+    if (worst)
+        *worst = largest;
+    return largest <= tolerance;
+}
+
 /* ---- words ---- */
 
 static double dot3(const double a[3], const double b[3])

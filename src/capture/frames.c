@@ -1,6 +1,6 @@
-/* The frames a physical-loop command reads: image files, videos, folders, or a webcam. */
+/* The frames the physical loop reads: image files, videos, folders, or a webcam (vf/frames.h). */
 #define _GNU_SOURCE
-#include "frames_in.h"
+#include "vf/frames.h"
 
 #include <dirent.h>
 #include <stdio.h>
@@ -21,7 +21,7 @@ static int has_extension(const char *path, const char *const *exts)
     return 0;
 }
 
-int frames_in_is_video_name(const char *path)
+int vf_is_video_name(const char *path)
 {
     static const char *const exts[] = {"mp4", "mov", "m4v", "mkv", "avi", "webm", "mpg", NULL};
     return has_extension(path, exts);
@@ -33,7 +33,7 @@ static int is_image_name(const char *path)
     return has_extension(path, exts);
 }
 
-static vf_status add_file(frames_in *in, const char *path)
+static vf_status add_file(vf_frames *in, const char *path)
 {
     char **files = realloc(in->files, sizeof *files * (size_t)(in->count + 1));
     if (!files)
@@ -51,7 +51,7 @@ static int compare_names(const void *a, const void *b)
 }
 
 /* A folder's images and videos, in name order. */
-static vf_status add_folder(frames_in *in, const char *folder)
+static vf_status add_folder(vf_frames *in, const char *folder)
 {
     DIR *dir = opendir(folder);
     if (!dir)
@@ -60,7 +60,7 @@ static vf_status add_folder(frames_in *in, const char *folder)
     struct dirent *e;
     vf_status status = VF_OK;
     while (status == VF_OK && (e = readdir(dir))) {
-        if (e->d_name[0] == '.' || !(is_image_name(e->d_name) || frames_in_is_video_name(e->d_name)))
+        if (e->d_name[0] == '.' || !(is_image_name(e->d_name) || vf_is_video_name(e->d_name)))
             continue;
         char path[VF_PATH_MAX];
         status = vf_path_join(path, sizeof path, folder, e->d_name);
@@ -75,7 +75,7 @@ static vf_status add_folder(frames_in *in, const char *folder)
     return status;
 }
 
-vf_status frames_in_open(char *const *args, int count, frames_in *in)
+vf_status vf_frames_open(char *const *args, int count, vf_frames *in)
 {
     memset(in, 0, sizeof *in);
     vf_status status = count > 0 ? VF_OK : vf_fail(VF_EINPUT, "give images, videos or folders");
@@ -84,7 +84,7 @@ vf_status frames_in_open(char *const *args, int count, frames_in *in)
             status = add_folder(in, args[i]);
         else if (!vf_is_file(args[i]))
             status = vf_fail(VF_EINPUT, "%s does not exist", args[i]);
-        else if (is_image_name(args[i]) || frames_in_is_video_name(args[i]))
+        else if (is_image_name(args[i]) || vf_is_video_name(args[i]))
             status = add_file(in, args[i]);
         else
             status = vf_fail(VF_EINPUT, "%s is neither an image (.jpg, .png) nor a video (.mp4, "
@@ -92,11 +92,11 @@ vf_status frames_in_open(char *const *args, int count, frames_in *in)
                              args[i]);
     }
     if (status != VF_OK)
-        frames_in_close(in);
+        vf_frames_close(in);
     return status;
 }
 
-vf_status frames_in_open_v4l2(const char *device, frames_in *in)
+vf_status vf_frames_open_v4l2(const char *device, vf_frames *in)
 {
     memset(in, 0, sizeof *in);
     vf_v4l2_request request = {1280, 720, 0, 0};
@@ -105,11 +105,11 @@ vf_status frames_in_open_v4l2(const char *device, frames_in *in)
     if (status == VF_OK)
         status = vf_v4l2_start(in->camera);
     if (status != VF_OK)
-        frames_in_close(in);
+        vf_frames_close(in);
     return status;
 }
 
-vf_status frames_in_next(frames_in *in, vf_rgb8 *frame, frame_info *info, int *got)
+vf_status vf_frames_next(vf_frames *in, vf_rgb8 *frame, vf_frame_info *info, int *got)
 {
     *got = 0;
     if (in->camera) {
@@ -141,7 +141,7 @@ vf_status frames_in_next(frames_in *in, vf_rgb8 *frame, frame_info *info, int *g
         if (in->next >= in->count)
             return VF_OK;
         const char *path = in->files[in->next++];
-        if (frames_in_is_video_name(path)) {
+        if (vf_is_video_name(path)) {
             vf_video_info vi;
             vf_status status = vf_video_open(path, &in->video, &vi);
             if (status != VF_OK)
@@ -161,7 +161,7 @@ vf_status frames_in_next(frames_in *in, vf_rgb8 *frame, frame_info *info, int *g
     }
 }
 
-void frames_in_close(frames_in *in)
+void vf_frames_close(vf_frames *in)
 {
     for (int i = 0; i < in->count; i++)
         free(in->files[i]);

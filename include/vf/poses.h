@@ -1,0 +1,59 @@
+/* vf/poses.h: the poses stage, camera poses for the ingested frames by structure from motion.
+ *
+ * WS/ingest/images -> WS/poses/ with COLMAP (vf/colmap.h; CPU, headless): the frames as COLMAP
+ * read them (images/, alpha composited on white), its database and log, its sparse model
+ * (sparse/, COLMAP's frame), and in the object frame (z up, object at the origin, cameras at
+ * a mean distance of 4; vf/normalize.h): transforms.json (OpenGL camera-to-world, COLMAP's
+ * lens), points3D.txt, normalization.json, and undistorted pinhole images (undistorted/) with
+ * transforms_undistorted.json. Fewer than min_registered of the frames registering is
+ * VF_EINPUT saying what usually causes it; a failed run keeps a copy of COLMAP's log in
+ * $TMPDIR and names it.
+ *
+ * The "auto" matcher chooses by what the frames are (the ingest report says): up to 40
+ * frames, all pairs; frames of a video or webcam, in capture order, sequential; a photo
+ * folder, whose file names say nothing about where the photos were taken, all pairs up to 150
+ * photos and beyond that retrieval (each photo with its 40 most similar by a vocabulary tree
+ * built from the capture's own features). The "auto" camera model is OPENCV, or SIMPLE_RADIAL
+ * when more than 40% of the frames' pixels are removed background (few features). */
+#ifndef VF_POSES_H
+#define VF_POSES_H
+
+#include <jansson.h>
+
+#include "vf/camera.h"
+#include "vf/error.h"
+#include "vf/workspace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vf_poses_options {
+    const char *matcher;      /* "auto", "sequential", "exhaustive", "retrieval" (auto) */
+    const char *camera_model; /* "auto" or a COLMAP model name (auto) */
+    const char *vocab_tree;   /* a tree for loop detection and retrieval, or NULL: build one */
+    int overlap;              /* sequential matching: neighbours per frame (10) */
+    int max_features;         /* SIFT features per frame (2048) */
+    double min_registered;    /* share of frames that must register (0.5) */
+    int undistort;            /* write the undistorted images (1) */
+    int has_intrinsics;       /* known camera, not refined: `known` holds it; width 0 means
+                               * "stated for the frames as they are", else it is scaled */
+    vf_camera known;
+    const char *camera_file; /* where `known` came from, or NULL (for the log) */
+} vf_poses_options;
+
+void vf_poses_defaults(vf_poses_options *o);
+
+/* VF_EINPUT naming the option that cannot run. */
+vf_status vf_poses_options_check(const vf_poses_options *o);
+
+/* Run the stage on an open workspace with an ingest. *summary gets {"registered", "total",
+ * "models", "unregistered", "reprojection_error_px", "points", "matcher", "camera_model",
+ * "cameras", "up_method", "center_method", "scale_to_object", "seconds" {per COLMAP step}}
+ * (a new reference). */
+vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **summary);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

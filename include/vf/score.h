@@ -1,0 +1,51 @@
+/* vf/score.h: the score stage, the physical attack success rate from a re-capture.
+ *
+ * Every frame of the inputs (vf/frames.h: images, videos, folders) is checked for blur
+ * (sharper than blur_ratio x the median of all of them), localized against the workspace's
+ * sparse model (vf/localize.h), and kept when its viewpoint lies within the tolerance box
+ * around v* (or exported target `target`); kept frames are classified, and the misclassified
+ * share is the physical ASR with a 95% Wilson interval. Localized frames outside the box are
+ * the natural-viewpoint control. Output in WS/score/: score.json {"workspace", "center",
+ * "center_viewpoint", "tolerance_percent", "model", "engine", "label", "kept" {"frames",
+ * "misclassified", "asr", "interval95", "predicted"}, "natural" {... "error_rate" ...},
+ * "rejected" {"blurry", "not_localized", "out_of_tolerance", "total"}, "frames",
+ * "localize_fps", "frames_detail" [per frame]} and frames.csv. */
+#ifndef VF_SCORE_H
+#define VF_SCORE_H
+
+#include <jansson.h>
+
+#include "vf/error.h"
+#include "vf/localize.h"
+#include "vf/workspace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct vf_score_options {
+    double tolerance;  /* box half-width, a share of each parameter's range (0.05) */
+    int target;        /* exported target to centre on; -1: v* (-1) */
+    const char *model; /* classifier; NULL: the attack's model, else the default */
+    double blur_ratio; /* frames sharper than this x the median are used (0.3) */
+    vf_localize_options loc;
+} vf_score_options;
+
+void vf_score_defaults(vf_score_options *o);
+
+/* Score input_count inputs against an open workspace that has an attack and poses. *result
+ * gets score.json's document without "frames_detail" (a new reference). */
+vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
+                       const vf_score_options *o, json_t **result);
+
+/* One row per workspace for a table across objects: {"object", "label", "natural_accuracy",
+ * "asr_v_star", "asr_samples" (the attack's renders), "real_natural_accuracy",
+ * "real_asr_v_star", "real_asr_samples" (the object itself, for a 3D model's `real`), and
+ * when `score` ran "physical_asr", "interval95", "misclassified", "frames_used"}; rates are
+ * -1 when unknown. VF_EINPUT naming a workspace with neither a score nor a real check. */
+vf_status vf_score_summary(char *const *workspaces, int count, json_t **rows);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,361 @@
+/* The poses stage (vf/poses.h): the flow, the normalization and the outputs; the COLMAP
+ * steps are in poses_colmap.c. */
+#define _GNU_SOURCE
+#include "vf/poses.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "poses_internal.h"
+#include "vf/dataset.h"
+#include "vf/ingest.h"
+#include "vf/log.h"
+#include "vf/normalize.h"
+#include "vf/sfm_export.h"
+
+/* The auto matcher (see choose_methods and the README's "Capturing well"). */
+#define EXHAUSTIVE_MAX_FRAMES 40  /* any capture: all pairs are affordable and the surest */
+#define EXHAUSTIVE_MAX_PHOTOS 150 /* unordered photos: all pairs up to here, then retrieval */
+
+static int one_of(const char *value, const char *const *choices)
+{
+    for (; *choices; choices++)
+        if (!strcmp(value, *choices))
+            return 1;
+    return 0;
+}
+
+void vf_poses_defaults(vf_poses_options *o)
+{
+    *o = (vf_poses_options){.matcher = "auto",
+                            .camera_model = "auto",
+                            .overlap = 10,
+                            .max_features = 2048,
+                            .min_registered = 0.5,
+                            .undistort = 1};
+}
+
+vf_status vf_poses_options_check(const vf_poses_options *o)
+{
+    static const char *const matchers[] = {"auto", "sequential", "exhaustive", "retrieval", NULL};
+    static const char *const models[] = {
+        "auto", "OPENCV", "SIMPLE_RADIAL", "RADIAL", "PINHOLE", "SIMPLE_PINHOLE", NULL};
+    if (!o->matcher || !one_of(o->matcher, matchers))
+        return vf_fail(VF_EINPUT, "--matcher: use auto, sequential, exhaustive or retrieval");
+    if (!o->camera_model || !one_of(o->camera_model, models))
+        return vf_fail(VF_EINPUT, "--camera-model: use auto, OPENCV, SIMPLE_RADIAL, RADIAL, "
+                                  "PINHOLE or SIMPLE_PINHOLE");
+    if (o->has_intrinsics && strcmp(o->camera_model, "auto"))
+        return vf_fail(VF_EINPUT, "known intrinsics choose the camera model themselves: drop "
+                                  "--camera-model");
+    if (o->vocab_tree && !vf_is_file(o->vocab_tree))
+        return vf_fail(VF_EINPUT, "--vocab-tree: %s does not exist", o->vocab_tree);
+    if (o->overlap < 1 || o->max_features < 100 ||
+        !(o->min_registered > 0 && o->min_registered <= 1))
+        return vf_fail(VF_EINPUT, "poses: overlap >= 1, max_features >= 100 and min_registered "
+                                  "in (0, 1] are needed");
+    return VF_OK;
+}
+
+/* Fit the known intrinsics to the frames' size (a calibration at another resolution of the
+ * same aspect is scaled). */
+static vf_status fit_known_camera(const vf_sfm_images *frames, vf_camera *cam)
+{
+    if (frames->size_groups > 1)
+        return vf_fail(VF_EINPUT,
+                       "the frames come in %d sizes, but known intrinsics fit one; "
+                       "drop --intrinsics/--camera or ingest frames of one size",
+                       frames->size_groups);
+    int w = frames->frames[0].width, h = frames->frames[0].height;
+    if (cam->width == 0) { /* --intrinsics: stated for the frames as they are */
+        cam->width = w;
+        cam->height = h;
+    } else if (cam->width != w || cam->height != h) {
+        if (abs(cam->width * h - cam->height * w) > (w > h ? w : h) / 50)
+            return vf_fail(VF_EINPUT,
+                           "the camera file is for %dx%d images, the frames are %dx%d "
+                           "(another aspect ratio or orientation)",
+                           cam->width, cam->height, w, h);
+        *cam = vf_camera_scaled(cam, w, h);
+    }
+    return VF_OK;
+}
+
+/* Resolve "auto" for the matcher and the camera model, and say what was chosen and why.
+ * Matching is chosen by what the frames are, not only how many: sequential matching of a
+ * photo folder pairs frames by file name, and with names not in capture order it gives a
+ * confident, wrong model (measured: 51 hash-named phone photos registered 51/51, 11.4 deg
+ * off; all pairs: 0.54 deg). */
+static void choose_methods(poses_run *run, const char *source)
+{
+    const vf_poses_options *opt = run->opt;
+    int n = run->frames.count;
+    int ordered = !strcmp(source, "video") || !strcmp(source, "camera");
+    run->matcher = opt->matcher;
+    if (!strcmp(run->matcher, "auto"))
+        run->matcher = n <= EXHAUSTIVE_MAX_FRAMES   ? "exhaustive"
+                       : ordered                    ? "sequential"
+                       : n <= EXHAUSTIVE_MAX_PHOTOS ? "exhaustive"
+                                                    : "retrieval";
+    const char *why = strcmp(opt->matcher, "auto") ? ""
+                      : n <= EXHAUSTIVE_MAX_FRAMES ? " (few frames)"
+                      : ordered                    ? " (frames of a video, in capture order)"
+                                : " (photos: file names say nothing about where they were taken)";
+    if (!strcmp(run->matcher, "sequential"))
+        vf_info("matching each frame with its next %d (and 2^k ahead)%s%s", opt->overlap,
+                opt->vocab_tree ? ", with loop detection" : "", why);
+    else if (!strcmp(run->matcher, "retrieval"))
+        vf_info("matching each of %d frames with its %d most similar (vocabulary tree)%s", n,
+                RETRIEVAL_IMAGES < n - 1 ? RETRIEVAL_IMAGES : n - 1, why);
+    else
+        vf_info("matching all %d pairs of %d frames%s", n * (n - 1) / 2, n, why);
+
+    if (opt->has_intrinsics)
+        run->camera_model = vf_camera_has_distortion(&opt->known) ? "OPENCV" : "PINHOLE";
+    else if (strcmp(opt->camera_model, "auto"))
+        run->camera_model = opt->camera_model;
+    else
+        run->camera_model = run->frames.background_fraction > 0.4 ? "SIMPLE_RADIAL" : "OPENCV";
+    vf_info("camera model %s%s", run->camera_model,
+            opt->has_intrinsics ? " (known intrinsics, not refined)"
+            : !strcmp(run->camera_model, "SIMPLE_RADIAL") && !strcmp(opt->camera_model, "auto")
+                ? " (background removed: few features, so a simpler lens)"
+                : "");
+}
+
+static vf_status prepare_frames(poses_run *run, const vf_workspace *ws)
+{
+    static const float white[3] = {1, 1, 1};
+    char ingest_images[VF_PATH_MAX];
+    double start = vf_now();
+    vf_status status =
+        vf_workspace_path(ws, "ingest", "images", ingest_images, sizeof ingest_images);
+    if (status == VF_OK)
+        status = vf_sfm_images_prepare(ingest_images, run->images, white, &run->frames);
+    if (status == VF_OK && run->opt->has_intrinsics)
+        status = fit_known_camera(&run->frames, &run->opt->known);
+    json_object_set_new(run->seconds, "prepare", json_real(vf_now() - start));
+    if (status == VF_OK && run->frames.count < 3)
+        status = vf_fail(VF_EINPUT,
+                         "only %d frames in WS/ingest/images: structure from motion "
+                         "needs at least 3 (better 20 or more)",
+                         run->frames.count);
+    return status;
+}
+
+/* Fewer than opt->min_registered of the frames in the model is an input problem. */
+static vf_status check_registration(const poses_run *run)
+{
+    int registered = run->model.image_count, total = run->frames.count;
+    if (registered >= run->opt->min_registered * total)
+        return VF_OK;
+    char split[96] = "";
+    if (run->model_count > 1)
+        snprintf(split, sizeof split, " (the scene fell apart into %d separate models)",
+                 run->model_count);
+    return vf_fail(VF_EINPUT,
+                   "COLMAP registered only %d of %d frames%s; this usually means blurry frames, "
+                   "too little texture (plain or removed backgrounds), or too little overlap "
+                   "between frames: try sharper frames taken closer together, --matcher "
+                   "exhaustive, --camera-model SIMPLE_RADIAL or more --max-features",
+                   registered, total, split);
+}
+
+/* The normalization of run->model, from its cameras and points. */
+static vf_status normalize_model(const poses_run *run, vf_normalization *norm)
+{
+    const vf_colmap_model *m = &run->model;
+    double *c2w = malloc((size_t)m->image_count * 16 * sizeof *c2w);
+    double *points = malloc((size_t)(m->point_count + 1) * 3 * sizeof *points);
+    vf_status status = VF_OK;
+    if (!c2w || !points)
+        status = vf_fail(VF_EINTERNAL, "out of memory");
+    for (int i = 0; status == VF_OK && i < m->image_count; i++)
+        vf_colmap_image_c2w(&m->images[i], c2w + 16 * i);
+    for (int i = 0; status == VF_OK && i < m->point_count; i++)
+        memcpy(points + 3 * i, m->points[i].xyz, 3 * sizeof *points);
+    if (status == VF_OK)
+        status = vf_normalize_scene(c2w, m->image_count, points, m->point_count, norm);
+    free(c2w);
+    free(points);
+    return status;
+}
+
+/* transforms(.json or _undistorted.json) for `model`, images under image_dir. */
+static vf_status save_transforms(const poses_run *run, const vf_colmap_model *model,
+                                 const vf_similarity *s, const char *image_dir, const char *file)
+{
+    char path[VF_PATH_MAX];
+    vf_dataset ds;
+    vf_status status = vf_path_join(path, sizeof path, run->stage.dir, file);
+    if (status == VF_OK)
+        status = vf_sfm_dataset(model, s, image_dir, &ds);
+    if (status == VF_OK) {
+        status = vf_dataset_save(path, &ds);
+        vf_dataset_free(&ds);
+    }
+    return status;
+}
+
+static vf_status export_outputs(poses_run *run, vf_normalization *norm)
+{
+    char path[VF_PATH_MAX];
+    vf_status status = normalize_model(run, norm);
+    const vf_similarity *s = &norm->object_from_world;
+    if (status == VF_OK)
+        status = vf_path_join(path, sizeof path, run->stage.dir, "normalization.json");
+    if (status == VF_OK)
+        status = vf_sfm_save_normalization(path, norm);
+    if (status == VF_OK)
+        status = vf_path_join(path, sizeof path, run->stage.dir, "points3D.txt");
+    if (status == VF_OK)
+        status = vf_sfm_save_points(path, &run->model, s);
+    if (status == VF_OK)
+        status = save_transforms(run, &run->model, s, run->images, "transforms.json");
+    if (status != VF_OK || !run->opt->undistort)
+        return status;
+    vf_colmap_model undistorted;
+    if ((status = vf__poses_undistort(run, &undistorted)) != VF_OK)
+        return status;
+    if ((status = vf_path_join(path, sizeof path, run->stage.dir, "undistorted/images")) == VF_OK)
+        status = save_transforms(run, &undistorted, s, path, "transforms_undistorted.json");
+    vf_colmap_model_free(&undistorted);
+    return status;
+}
+
+static json_t *cameras_json(const vf_colmap_model *m)
+{
+    json_t *list = json_array();
+    for (int i = 0; i < m->camera_count; i++) {
+        const vf_colmap_camera *c = &m->cameras[i];
+        json_t *params = json_array();
+        for (int k = 0; k < c->param_count; k++)
+            json_array_append_new(params, json_real(c->params[k]));
+        json_array_append_new(list, json_pack("{s:i, s:s, s:i, s:i, s:o}", "id", c->id, "model",
+                                              c->model, "width", c->width, "height", c->height,
+                                              "params", params));
+    }
+    return list;
+}
+
+static json_t *unregistered_json(const poses_run *run)
+{
+    json_t *list = json_array();
+    for (int i = 0; i < run->frames.count; i++) {
+        int found = 0;
+        for (int j = 0; j < run->model.image_count && !found; j++)
+            found = !strcmp(run->frames.frames[i].name, run->model.images[j].name);
+        if (!found)
+            json_array_append_new(list, json_string(run->frames.frames[i].name));
+    }
+    return list;
+}
+
+static json_t *summarize(const poses_run *run, const vf_normalization *norm)
+{
+    const vf_colmap_model *m = &run->model;
+    return json_pack("{s:i, s:i, s:i, s:o, s:f, s:i, s:s, s:s, s:o, s:s, s:s, s:f, s:O}",
+                     "registered", m->image_count, "total", run->frames.count, "models",
+                     run->model_count, "unregistered", unregistered_json(run),
+                     "reprojection_error_px", vf_colmap_model_reprojection_error(m), "points",
+                     m->point_count, "matcher", run->matcher, "camera_model", run->camera_model,
+                     "cameras", cameras_json(m), "up_method", norm->up_method, "center_method",
+                     norm->center_method, "scale_to_object", norm->object_from_world.scale,
+                     "seconds", run->seconds);
+}
+
+/* Everything inside the staging folder; *summary on success. */
+static vf_status run_stage(poses_run *run, const vf_workspace *ws, json_t **summary)
+{
+    char log_path[VF_PATH_MAX];
+    vf_normalization norm;
+    vf_status status = vf_path_join(run->scratch, sizeof run->scratch, run->stage.dir, ".colmap");
+    if (status == VF_OK)
+        status = vf_path_join(run->images, sizeof run->images, run->stage.dir, "images");
+    if (status == VF_OK)
+        status = vf_path_join(run->database, sizeof run->database, run->stage.dir, "database.db");
+    if (status == VF_OK)
+        status = vf_path_join(log_path, sizeof log_path, run->stage.dir, "colmap.log");
+    if (status == VF_OK)
+        status = vf_mkdirs(run->scratch);
+    if (status == VF_OK)
+        status = vf_colmap_open(&run->colmap, log_path);
+    if (status == VF_OK)
+        status = prepare_frames(run, ws);
+    if (status != VF_OK)
+        return status;
+    char source[32];
+    vf_ingest_source_kind(ws->root, source, sizeof source);
+    choose_methods(run, source);
+    if ((status = vf__poses_extract_features(run)) == VF_OK &&
+        (status = vf__poses_match(run)) == VF_OK && (status = vf__poses_map(run)) == VF_OK &&
+        (status = check_registration(run)) == VF_OK)
+        status = export_outputs(run, &norm);
+    if (status == VF_OK) {
+        json_object_set_new(run->seconds, "total", json_real(vf_now() - run->stage.start_time));
+        *summary = summarize(run, &norm);
+        status = vf_remove_tree(run->scratch);
+    }
+    return status;
+}
+
+/* A failed run's COLMAP log would go with the staging folder: keep a copy in $TMPDIR (or
+ * /tmp) and name it at the end of the message; `status` is returned unchanged. */
+static vf_status keep_failure_log(const poses_run *run, vf_status status)
+{
+    struct stat info;
+    if (!run->colmap.log_path[0] || stat(run->colmap.log_path, &info) != 0 || info.st_size == 0)
+        return status; /* no log, or COLMAP never ran */
+    const char *tmp = getenv("TMPDIR");
+    char copy[VF_PATH_MAX], message[1024];
+    snprintf(copy, sizeof copy, "%s/vfcapture-poses-XXXXXX.log", tmp && *tmp ? tmp : "/tmp");
+    int fd = mkstemps(copy, 4);
+    if (fd < 0)
+        return status;
+    close(fd);
+    snprintf(message, sizeof message, "%s", vf_error_message());
+    if (vf_copy_file(run->colmap.log_path, copy) == VF_OK)
+        vf_fail(status, "%s (COLMAP's log: %s)", message, copy);
+    else
+        unlink(copy);
+    return status;
+}
+
+vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **summary)
+{
+    *summary = NULL;
+    vf_status status = vf_poses_options_check(o);
+    if (status != VF_OK)
+        return status;
+    if (!vf_workspace_has_stage(ws, "ingest"))
+        return vf_fail(VF_EINPUT,
+                       "workspace %s has no ingested frames: run 'vfcapture ingest "
+                       "... -o %s' first",
+                       ws->root, ws->root);
+    vf_poses_options opt = *o; /* the known camera is fitted to the frames' size */
+    poses_run run = {.opt = &opt, .seconds = json_object()};
+    status = vf_stage_begin(ws, "poses", &run.stage);
+    if (status == VF_OK)
+        status = run_stage(&run, ws, summary);
+    vf_colmap_close(&run.colmap);
+    if (status == VF_OK) {
+        json_t *params = json_pack("{s:s, s:s, s:i, s:i, s:f, s:b}", "matcher", opt.matcher,
+                                   "camera_model", opt.camera_model, "overlap", opt.overlap,
+                                   "max_features", opt.max_features, "min_registered",
+                                   opt.min_registered, "known_intrinsics", opt.has_intrinsics);
+        status = vf_stage_commit(&run.stage, params, json_deep_copy(*summary));
+    } else {
+        status = keep_failure_log(&run, status);
+        vf_stage_abort(&run.stage);
+    }
+    if (status != VF_OK) {
+        json_decref(*summary);
+        *summary = NULL;
+    }
+    vf_colmap_model_free(&run.model);
+    vf_sfm_images_free(&run.frames);
+    json_decref(run.seconds);
+    return status;
+}
