@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../src/opencv/calib_cv.h"
+#include "calib_cv.h"
 #include "calib_internal.h"
 
 int vf_calib_board_corners(const vf_calib_board *board)

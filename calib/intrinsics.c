@@ -4,8 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../src/ceres/calib_refine.h"
-#include "../src/opencv/calib_cv.h"
+#include "calib_ceres.h"
+#include "calib_cv.h"
 #include "calib_internal.h"
 #include "vf/log.h"
 #include "vf/pose.h"

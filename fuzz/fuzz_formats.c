@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../src/onnx_shape.h"
+#include "../src/classify/onnx_shape.h"
 #include "vf/calib.h"
 #include "vf/colmap_model.h"
 #include "vf/dataset.h"

@@ -12,9 +12,10 @@
 
 static const char usage[] =
     "usage: vfcapture attack WS [--model NAME|PATH] [--label L1,L2,...]\n"
-    "                       [--method nes|pepg|random] [--lambda X] [--samples K] [--steps N] [--components K]\n"
+    "                       [--method nes|pepg|random] [--lambda X] [--samples K] [--steps N] "
+    "[--components K]\n"
     "                       [--space rotation|translation|both] [--bounds name=lo:hi,...]\n"
-    "                       [--seed S] [--resume] [--json]\n"
+    "                       [--seed S] [--restart] [--json]\n"
     "\n"
     "Find the viewpoints from which the classifier misreads the object (ViewFool, Dong et al.,\n"
     "NeurIPS 2022): learn a distribution p(v) over viewpoints v = (psi, theta, phi in degrees,\n"
@@ -44,7 +45,9 @@ static const char usage[] =
     "                         phi 20:160, dx -0.5:0.5, dy -1:1, dz -0.5:0.5; for a real capture\n"
     "                         (poses stage) the range its photos cover\n"
     "      --seed S           random seed (default 0): the same seed gives the same result\n"
-    "      --resume           continue an interrupted attack from its last step\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
+    "      --restart          discard an interrupted attack (by default a run with the same\n"
+    "                         settings continues it from its last step)\n" CLI_ENGINE_HELP
+        CLI_COMMON_HELP;
 
 enum {
     OPT_MODELS_DIR = CLI_OPT_FIRST_CUSTOM,
@@ -54,7 +57,7 @@ enum {
     OPT_SPACE,
     OPT_BOUNDS,
     OPT_SEED,
-    OPT_RESUME,
+    OPT_RESTART,
 };
 
 typedef struct attack_cli {
@@ -98,7 +101,7 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
         {"space", required_argument, NULL, OPT_SPACE},
         {"bounds", required_argument, NULL, OPT_BOUNDS},
         {"seed", required_argument, NULL, OPT_SEED},
-        {"resume", no_argument, NULL, OPT_RESUME},
+        {"restart", no_argument, NULL, OPT_RESTART},
         {0, 0, 0, 0},
     };
     vf_attack_options *o = &cli->attack;
@@ -134,7 +137,7 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
             if (end == optarg || *end || optarg[0] == '-')
                 s = vf_fail(VF_EINPUT, "--seed must be a whole number >= 0, not '%s'", optarg);
             break;
-        case OPT_RESUME: o->resume = 1; break;
+        case OPT_RESTART: o->restart = 1; break;
         default: break;
         }
     }

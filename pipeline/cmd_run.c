@@ -1,20 +1,22 @@
 /* vfcapture run: the whole pipeline on one capture, resuming where it left off.
  *
- * Runs ingest, poses, train, attack and export by calling each stage's command in-process with
- * the arguments a user would type. WS/run.json remembers, per stage, the arguments it ran with
- * and the completion stamp the manifest gave it; a stage is redone when its output is missing,
- * its arguments changed, it was re-run by hand since, or a stage before it was redone. */
-#define _GNU_SOURCE
+ * Calls each stage's library function (vf_ingest_run, vf_poses_run, vf_train_run,
+ * vf_attack_run, vf_real_run, vf_export_run) in turn. WS/run.json remembers, per stage, the
+ * settings it ran with and the completion stamp the manifest gave it; a stage is redone when
+ * its output is missing, its settings changed, it was re-run by hand since, or a stage before
+ * it was redone. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "cli.h"
-#include "vf/object3d.h"
-#include "vf/fsutil.h"
+#include "vf/attack.h"
+#include "vf/export.h"
+#include "vf/ingest.h"
 #include "vf/log.h"
-#include "vf/workspace.h"
+#include "vf/object3d.h"
+#include "vf/poses.h"
+#include "vf/train.h"
 
 static const char usage[] =
     "usage: vfcapture run VIDEO|PHOTO_FOLDER|TRANSFORMS_JSON|MODEL.glb -o WS [options]\n"
@@ -40,109 +42,76 @@ static const char usage[] =
 
 enum { OPT_MINUTES = CLI_OPT_FIRST_CUSTOM, OPT_TRAIN_STEPS, OPT_SAMPLES, OPT_STEPS, OPT_RESTART };
 
-#define MAX_STAGE_ARGS 24
-
 typedef struct run_options {
-    const char *input;
     const char *workspace;
-    const char *model, *label, *frames, *minutes, *train_steps, *samples, *steps;
+    vf_ingest_request ingest;
+    vf_poses_options poses;
+    vf_train_options train;
+    vf_attack_options attack;
+    vf_real_options real;
+    vf_export_options export_;
     int restart;
     cli_flags flags;
 } run_options;
 
+/* One stage: its name, how to run it, and the settings run.json remembers it by. */
 typedef struct stage_call {
     const char *name;
-    int (*run)(int argc, char **argv);
-    char *argv[MAX_STAGE_ARGS];
-    int argc;
+    vf_status (*run)(vf_workspace *ws, const run_options *o, json_t **out);
+    json_t *settings;
 } stage_call;
 
-static void push(stage_call *call, const char *arg)
+/* The stages as run calls them; *out is the stage's result document. */
+static vf_status ingest(vf_workspace *ws, const run_options *o, json_t **out)
 {
-    if (call->argc < MAX_STAGE_ARGS - 1)
-        call->argv[call->argc++] = (char *)arg;
-    call->argv[call->argc] = NULL;
+    return vf_ingest_run(ws->root, &o->ingest, out);
+}
+static vf_status poses(vf_workspace *ws, const run_options *o, json_t **out)
+{
+    return vf_poses_run(ws, &o->poses, out);
+}
+static vf_status train(vf_workspace *ws, const run_options *o, json_t **out)
+{
+    return vf_train_run(ws, &o->train, out);
+}
+static vf_status attack(vf_workspace *ws, const run_options *o, json_t **out)
+{
+    return vf_attack_run(ws, &o->attack, out);
+}
+static vf_status real(vf_workspace *ws, const run_options *o, json_t **out)
+{
+    return vf_real_run(ws, &o->real, out);
+}
+static vf_status export_targets(vf_workspace *ws, const run_options *o, json_t **out)
+{
+    return vf_export_run(ws, &o->export_, out);
 }
 
-static void push_option(stage_call *call, const char *option, const char *value)
-{
-    if (value) {
-        push(call, option);
-        push(call, value);
-    }
-}
+static json_t *text_or_null(const char *text) { return text ? json_string(text) : json_null(); }
 
-static int is_transforms_file(const char *path)
+/* The stages this input needs, each with the settings that make its output what it is. */
+static int plan_stages(const run_options *o, stage_call *calls)
 {
-    size_t n = strlen(path);
-    return vf_is_file(path) && n > 5 && !strcmp(path + n - 5, ".json");
-}
-
-/* The stages this input needs, with the arguments each is called with. */
-static int plan_stages(const run_options *opt, stage_call *calls)
-{
+    const vf_ingest_kind kind = o->ingest.kind;
+    const vf_ingest_options *cap = &o->ingest.capture;
     int n = 0;
-    stage_call *c = &calls[n++];
-    *c = (stage_call){.name = "ingest", .run = cmd_ingest};
-    push(c, "ingest");
-    int model = vf_object3d_is_model(opt->input); /* posed by Blender; checked by `real` */
-    if (is_transforms_file(opt->input)) {
-        push_option(c, "--transforms", opt->input);
-    } else if (model) {
-        push(c, opt->input);
-    } else {
-        push(c, opt->input);
-        push_option(c, "--frames", opt->frames);
-    }
-    push_option(c, "--output", opt->workspace);
-
-    if (!is_transforms_file(opt->input) && !model) {
-        c = &calls[n++];
-        *c = (stage_call){.name = "poses", .run = cmd_poses};
-        push(c, "poses");
-        push(c, opt->workspace);
-    }
-
-    c = &calls[n++];
-    *c = (stage_call){.name = "train", .run = cmd_train};
-    push(c, "train");
-    push(c, opt->workspace);
-    push_option(c, "--minutes", opt->minutes);
-    push_option(c, "--steps", opt->train_steps);
-
-    c = &calls[n++];
-    *c = (stage_call){.name = "attack", .run = cmd_attack};
-    push(c, "attack");
-    push(c, opt->workspace);
-    push_option(c, "--model", opt->model);
-    push_option(c, "--label", opt->label);
-    push_option(c, "--samples", opt->samples);
-    push_option(c, "--steps", opt->steps);
-
-    if (model) {
-        c = &calls[n++];
-        *c = (stage_call){.name = "real", .run = cmd_real};
-        push(c, "real");
-        push(c, opt->workspace);
-    }
-
-    c = &calls[n++];
-    *c = (stage_call){.name = "export", .run = cmd_export};
-    push(c, "export");
-    push(c, opt->workspace);
-
-    if (opt->flags.quiet)
-        for (int i = 0; i < n; i++)
-            push(&calls[i], "--quiet");
+    calls[n++] =
+        (stage_call){"ingest", ingest,
+                     json_pack("{s:s, s:s, s:i}", "input", o->ingest.input, "kind",
+                               vf_ingest_kind_name(kind), "frames", cap->select.max_frames)};
+    if (kind != VF_INGEST_TRANSFORMS && kind != VF_INGEST_MODEL)
+        calls[n++] = (stage_call){"poses", poses, json_object()};
+    calls[n++] = (stage_call){
+        "train", train,
+        json_pack("{s:f, s:i}", "minutes", o->train.minutes, "steps", o->train.steps)};
+    calls[n++] = (stage_call){"attack", attack,
+                              json_pack("{s:s, s:o, s:i, s:i}", "model", o->attack.model, "label",
+                                        text_or_null(o->attack.label), "samples",
+                                        o->attack.samples, "steps", o->attack.steps)};
+    if (kind == VF_INGEST_MODEL) /* posed by Blender; the attack checked on the object */
+        calls[n++] = (stage_call){"real", real, json_object()};
+    calls[n++] = (stage_call){"export", export_targets, json_object()};
     return n;
-}
-
-static json_t *args_json(const stage_call *call)
-{
-    json_t *list = json_array();
-    for (int i = 1; i < call->argc; i++)
-        json_array_append_new(list, json_string(call->argv[i]));
-    return list;
 }
 
 static const char *completed_stamp(const vf_workspace *ws, const char *stage)
@@ -150,19 +119,26 @@ static const char *completed_stamp(const vf_workspace *ws, const char *stage)
     return json_string_value(json_object_get(vf_workspace_stage_record(ws, stage), "completed"));
 }
 
-/* Whether a stage's output is there, made by run with these arguments, and not redone since. */
+/* Whether a stage's output is there, made by run with these settings, and not redone since. */
 static int stage_is_current(const vf_workspace *ws, const json_t *memory, const stage_call *call)
 {
     const json_t *last = json_object_get(memory, call->name);
     const char *stamp = completed_stamp(ws, call->name);
-    json_t *args = args_json(call);
-    int current = stamp && last && json_equal(json_object_get(last, "args"), args) &&
-                  !strcmp(stamp, json_string_value(json_object_get(last, "completed")) ?: "");
-    json_decref(args);
-    return current;
+    return stamp && last && json_equal(json_object_get(last, "settings"), call->settings) &&
+           !strcmp(stamp, json_string_value(json_object_get(last, "completed")) ?: "");
 }
 
-static vf_status parse_options(int argc, char **argv, run_options *opt)
+static vf_status parse_count(const char *option, const char *text, long lo, long hi, int *out)
+{
+    long n;
+    if (cli_parse_int(text, lo, hi, &n))
+        return vf_fail(VF_EINPUT, "%s wants a whole number from %ld to %ld, not '%s'", option, lo,
+                       hi, text);
+    *out = (int)n;
+    return VF_OK;
+}
+
+static vf_status parse_options(int argc, char **argv, run_options *o)
 {
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
@@ -178,56 +154,50 @@ static vf_status parse_options(int argc, char **argv, run_options *opt)
         {"restart", no_argument, NULL, OPT_RESTART},
         {0, 0, 0, 0},
     };
+    vf_ingest_request_defaults(&o->ingest);
+    vf_poses_defaults(&o->poses);
+    vf_train_defaults(&o->train);
+    vf_attack_defaults(&o->attack);
+    vf_real_defaults(&o->real);
+    vf_export_defaults(&o->export_);
     int c;
-    while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "o:m:l:n:", longopts, NULL)) != -1) {
-        if (cli_common_option(c, &opt->flags, "run", usage))
+    vf_status s = VF_OK;
+    while (s == VF_OK &&
+           (c = getopt_long(argc, argv, CLI_COMMON_SHORT "o:m:l:n:", longopts, NULL)) != -1) {
+        if (cli_common_option(c, &o->flags, "run", usage))
             continue;
         switch (c) {
-        case 'o': opt->workspace = optarg; break;
-        case 'm': opt->model = optarg; break;
-        case 'l': opt->label = optarg; break;
-        case 'n': opt->frames = optarg; break;
-        case OPT_MINUTES: opt->minutes = optarg; break;
-        case OPT_TRAIN_STEPS: opt->train_steps = optarg; break;
-        case OPT_SAMPLES: opt->samples = optarg; break;
-        case OPT_STEPS: opt->steps = optarg; break;
-        case OPT_RESTART: opt->restart = 1; break;
+        case 'o': o->workspace = optarg; break;
+        case 'm': o->attack.model = optarg; break;
+        case 'l': o->attack.label = optarg; break;
+        case 'n':
+            s = parse_count("--frames", optarg, 1, 100000, &o->ingest.capture.select.max_frames);
+            break;
+        case OPT_MINUTES:
+            if (cli_parse_doubles(optarg, &o->train.minutes, 1) != 1 ||
+                !(o->train.minutes > 0 && o->train.minutes <= 600))
+                s = vf_fail(VF_EINPUT, "--minutes must be a number above 0 (up to 600), not '%s'",
+                            optarg);
+            break;
+        case OPT_TRAIN_STEPS:
+            s = parse_count("--train-steps", optarg, 1, 10000000, &o->train.steps);
+            break;
+        case OPT_SAMPLES:
+            s = parse_count("--samples", optarg, 2, 100000, &o->attack.samples);
+            break;
+        case OPT_STEPS: s = parse_count("--steps", optarg, 0, 100000, &o->attack.steps); break;
+        case OPT_RESTART: o->restart = 1; break;
         }
     }
+    if (s != VF_OK)
+        return s;
     if (optind != argc - 1)
         return vf_fail(VF_EINPUT, "give one video, photo folder, transforms.json or 3D model "
                                   "(see 'vfcapture run --help')");
-    opt->input = argv[optind];
-    if (!opt->workspace)
+    o->ingest.input = argv[optind];
+    if (!o->workspace)
         return vf_fail(VF_EINPUT, "give the workspace folder with -o WS");
-    if (!vf_is_file(opt->input) && !vf_is_dir(opt->input))
-        return vf_fail(VF_EINPUT, "cannot read %s: no such file or folder", opt->input);
-    return VF_OK;
-}
-
-/* Run one stage's command; a failure keeps its exit code (the stage printed why). With
- * --json the stages' own reports go to stderr, so stdout carries run's JSON alone. */
-static int run_stage(stage_call *call, int index, int count, int json)
-{
-    int saved_stdout = -1;
-    fflush(stdout);
-    if (json && (saved_stdout = dup(STDOUT_FILENO)) >= 0)
-        dup2(STDERR_FILENO, STDOUT_FILENO);
-    vf_info("== stage %d of %d: %s ==", index + 1, count, call->name);
-    /* getopt_long reorders the argv it is given: hand over a copy, keep ours for run.json */
-    char *argv[MAX_STAGE_ARGS];
-    memcpy(argv, call->argv, sizeof argv);
-    optind = 0; /* each command parses its own argv from the start */
-    double start = vf_now();
-    int code = call->run(call->argc, argv);
-    if (code == 0)
-        vf_info("== %s done in %.0f s ==", call->name, vf_now() - start);
-    fflush(stdout);
-    if (saved_stdout >= 0) {
-        dup2(saved_stdout, STDOUT_FILENO);
-        close(saved_stdout);
-    }
-    return code;
+    return vf_ingest_input_kind(o->ingest.input, &o->ingest.kind);
 }
 
 static void print_summary(const vf_workspace *ws, const run_options *opt, double seconds)
@@ -252,51 +222,64 @@ static void print_summary(const vf_workspace *ws, const run_options *opt, double
            report, ws->root);
 }
 
-int cmd_run(int argc, char **argv)
+/* Run the stages in order from the first one that is not current; each stage updates the
+ * manifest itself, so the workspace is read again after it. */
+static vf_status run_stages(vf_workspace *ws, const run_options *o, stage_call *calls, int count,
+                            json_t *memory, const char *memory_path)
 {
-    run_options opt = {0};
-    vf_status status = parse_options(argc, argv, &opt);
-    if (status != VF_OK)
-        return cli_fail("run", status);
-
-    stage_call calls[6];
-    int count = plan_stages(&opt, calls);
-    char memory_path[VF_PATH_MAX];
-    vf_workspace ws;
-    if ((status = vf_workspace_open(opt.workspace, 1, &ws)) != VF_OK ||
-        (status = vf_path_join(memory_path, sizeof memory_path, ws.root, "run.json")) != VF_OK)
-        return cli_fail("run", status);
-    json_t *memory = NULL;
-    if (vf_is_file(memory_path) && vf_json_load(memory_path, &memory) != VF_OK)
-        vf_warn("ignoring unreadable %s: every stage runs again", memory_path);
-    if (!memory)
-        memory = json_object();
-
-    double start = vf_now();
-    int redo = opt.restart, code = 0;
-    for (int i = 0; i < count && code == 0; i++) {
-        redo = redo || !stage_is_current(&ws, memory, &calls[i]);
+    int redo = o->restart;
+    vf_status s = VF_OK;
+    for (int i = 0; i < count && s == VF_OK; i++) {
+        redo = redo || !stage_is_current(ws, memory, &calls[i]);
         if (!redo) {
             vf_info("== stage %d of %d: %s is up to date ==", i + 1, count, calls[i].name);
             continue;
         }
-        vf_workspace_close(&ws); /* the stage updates the manifest itself */
-        code = run_stage(&calls[i], i, count, opt.flags.json);
-        if ((status = vf_workspace_open(opt.workspace, 0, &ws)) != VF_OK) {
-            json_decref(memory);
-            return cli_fail("run", status);
+        vf_info("== stage %d of %d: %s ==", i + 1, count, calls[i].name);
+        double start = vf_now();
+        json_t *result = NULL;
+        s = calls[i].run(ws, o, &result);
+        json_decref(result);
+        vf_workspace_close(ws);
+        vf_status reopened = vf_workspace_open(o->workspace, 0, ws);
+        if (s == VF_OK && (s = reopened) == VF_OK) {
+            vf_info("== %s done in %.0f s ==", calls[i].name, vf_now() - start);
+            json_object_set_new(memory, calls[i].name,
+                                json_pack("{s:O, s:s}", "settings", calls[i].settings, "completed",
+                                          completed_stamp(ws, calls[i].name) ?: ""));
+            s = vf_json_save(memory_path, memory);
+        } else if (s != VF_OK) {
+            vf_error_prefix("stage %s", calls[i].name);
         }
-        if (code != 0)
-            break;
-        json_object_set_new(memory, calls[i].name,
-                            json_pack("{s:o, s:s}", "args", args_json(&calls[i]), "completed",
-                                      completed_stamp(&ws, calls[i].name) ?: ""));
-        if ((status = vf_json_save(memory_path, memory)) != VF_OK)
-            code = cli_fail("run", status);
     }
-    if (code == 0)
-        print_summary(&ws, &opt, vf_now() - start);
+    return s;
+}
+
+int cmd_run(int argc, char **argv)
+{
+    run_options o = {0};
+    stage_call calls[6];
+    int count = 0;
+    char memory_path[VF_PATH_MAX];
+    vf_workspace ws = {0};
+    json_t *memory = NULL;
+    vf_status s = parse_options(argc, argv, &o);
+    if (s == VF_OK)
+        count = plan_stages(&o, calls);
+    if (s == VF_OK && (s = vf_workspace_open(o.workspace, 1, &ws)) == VF_OK &&
+        (s = vf_path_join(memory_path, sizeof memory_path, ws.root, "run.json")) == VF_OK) {
+        if (vf_is_file(memory_path) && vf_json_load(memory_path, &memory) != VF_OK)
+            vf_warn("ignoring unreadable %s: every stage runs again", memory_path);
+        if (!memory)
+            memory = json_object();
+        double start = vf_now();
+        s = run_stages(&ws, &o, calls, count, memory, memory_path);
+        if (s == VF_OK)
+            print_summary(&ws, &o, vf_now() - start);
+    }
+    for (int i = 0; i < count; i++)
+        json_decref(calls[i].settings);
     json_decref(memory);
     vf_workspace_close(&ws);
-    return code;
+    return s == VF_OK ? 0 : cli_fail("run", s);
 }

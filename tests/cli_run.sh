@@ -74,4 +74,30 @@ one_line_naming "render: truncated model" "model.vff"
 cp "$tmp/model.keep" "$ws/train/model.vff"
 cmp -s "$ws/manifest.json" "$tmp/manifest.before" && ok || bad "failed commands left the manifest as it was"
 
+# An interrupted attack continues from its checkpoint (the old code never resumed one, and
+# --resume refused every real capture), other settings are refused naming --restart, and
+# --restart says what it discards.
+attack=(attack "$ws" --steps 10 --samples 6 --label "folding chair")
+"$tool" "${attack[@]}" --quiet 2>/dev/null &
+pid=$!
+checkpoint="$ws/.attack.partial/checkpoint.json"
+for _ in $(seq 600); do
+  python3 -c 'import json,sys; sys.exit(0 if json.load(open(sys.argv[1]))["state"]["step"] >= 3 else 1)' "$checkpoint" 2>/dev/null && break
+  sleep 0.2
+done
+kill "$pid"; wait "$pid" 2>/dev/null  # TERM: a background job ignores INT
+[ -f "$checkpoint" ] && ok || bad "the interrupted attack left its checkpoint"
+expect 1 "other settings" -- "$tool" attack "$ws" --steps 30 --samples 6 --label "folding chair"
+grep -q -- "--restart" "$tmp/err" && ok || bad "other settings are refused naming --restart: $(tail -1 "$tmp/err")"
+expect 0 "the attack continues" -- "$tool" "${attack[@]}" --json
+grep -Eq "continuing the interrupted attack at step [3-9] of 10" "$tmp/err" && ok || bad "continued mid-way: $(grep -i continu "$tmp/err")"
+json_check "all 10 steps in the result" 'len(d["loss_per_step"]) == 10'
+[ ! -e "$checkpoint" ] && ok || bad "the checkpoint goes once the attack is committed"
+"$tool" "${attack[@]}" --steps 5 --quiet 2>/dev/null &
+pid=$!
+for _ in $(seq 600); do [ -f "$checkpoint" ] && break; sleep 0.2; done
+kill "$pid"; wait "$pid" 2>/dev/null  # TERM: a background job ignores INT
+expect 0 "--restart" -- "$tool" "${attack[@]}" --steps 2 --restart
+grep -q "discarding what an interrupted run left" "$tmp/err" && ok || bad "--restart says it discards the checkpoint: $(head -3 "$tmp/err")"
+
 cli_finish

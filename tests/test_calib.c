@@ -1,5 +1,5 @@
 /* Calibration and metric scale on synthetic views: a checkerboard and an ArUco marker rendered
- * through a known lens (src/opencv/calib_cv.cpp) must give that lens and that scale back. */
+ * through a known lens (calib/calib_cv.cpp) must give that lens and that scale back. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,10 +1,10 @@
-/* The ONNX input-shape walker (src/onnx_shape.c) on protobuf messages built here: the first
- * input that is not an initializer, symbolic dimensions, malformed data, and a model that
+/* The ONNX input-shape walker (src/classify/onnx_shape.c) on protobuf messages built here: the
+ * first input that is not an initializer, symbolic dimensions, malformed data, and a model that
  * lists thousands of weights among its inputs (once quadratic: 31 s for a 3.7 MB model). */
 #include <stdlib.h>
 #include <string.h>
 
-#include "../src/onnx_shape.h"
+#include "../src/classify/onnx_shape.h"
 #include "check.h"
 #include "vf/log.h"
 

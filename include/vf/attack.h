@@ -15,10 +15,11 @@
  * fluctuation and the random-search baseline (vf/attack_eval.h); write attack.json
  * (vf/attack_file.h), v_star.png, samples.png, loss.png and fluctuation.png; commit.
  *
- * Life cycle: a failure after the stage began leaves its staging folder and checkpoint;
- * `resume` continues from that checkpoint when the model, labels and settings are the same
- * (VF_EINPUT when they differ), otherwise a run starts afresh. The checkpoint is removed only
- * once the new output is committed. */
+ * Life cycle, as every stage with a checkpoint (train, a model's ingest, real): a failure
+ * after the stage began leaves its staging folder and checkpoint, and the next run continues
+ * from it when the model, labels and settings are the same; other settings are refused
+ * (VF_EINPUT naming `--restart`), and `restart` discards the checkpoint, saying so. The
+ * checkpoint is removed only once the new output is committed. */
 #ifndef VF_ATTACK_H
 #define VF_ATTACK_H
 
@@ -55,7 +56,7 @@ typedef struct vf_attack_options {
     vf_view_space space;     /* VF_SPACE_BOTH */
     const char *bounds;      /* "psi=-90:90,..." applied last (vf_view_bounds_parse), or NULL */
     uint64_t seed;           /* 0: the same seed gives the same result */
-    int resume;              /* continue an interrupted attack (see the top comment) */
+    int restart;             /* discard an interrupted attack's checkpoint (see the top) */
 } vf_attack_options;
 
 void vf_attack_defaults(vf_attack_options *o);

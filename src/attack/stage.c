@@ -250,7 +250,7 @@ static vf_status save_checkpoint(const attack_run *run, const vf_attack_state *s
     return s;
 }
 
-/* resume: continue from the staging folder's checkpoint when it matches this run. */
+/* Continue from the staging folder's checkpoint when there is one and it matches this run. */
 static vf_status load_checkpoint(attack_run *run, vf_attack_state *st)
 {
     char path[VF_PATH_MAX];
@@ -258,25 +258,22 @@ static vf_status load_checkpoint(attack_run *run, vf_attack_state *st)
     vf_status s = vf_path_join(path, sizeof path, run->stage.dir, CHECKPOINT);
     if (s != VF_OK)
         return s;
-    if (!vf_is_file(path)) {
-        vf_info("resume: no interrupted attack in %s; starting afresh", run->ws->root);
+    if (run->opt->restart || !vf_is_file(path))
         return vf_attack_init(st, &run->cfg);
-    }
     if ((s = vf_json_load(path, &doc)) != VF_OK)
         return s;
     json_t *setup = setup_json(run);
     if (!json_equal(setup, json_object_get(doc, "setup")))
         s = vf_fail(VF_EINPUT,
-                    "the interrupted attack in %s used other settings (model, "
-                    "labels or options): run again with the same options, or without "
-                    "--resume",
+                    "the interrupted attack in %s used other settings (model, labels or "
+                    "options): give the same to continue it, or --restart",
                     run->ws->root);
     if (s == VF_OK)
         s = vf_attack_state_from_json(json_object_get(doc, "state"), st);
     if (s == VF_OK) {
         run->resumed_seconds = json_number_value(json_object_get(doc, "seconds"));
-        vf_info("resume: continuing the interrupted attack at step %d of %d", st->step,
-                run->cfg.steps);
+        vf_info("continuing the interrupted attack at step %d of %d (--restart to start over)",
+                st->step, run->cfg.steps);
     }
     json_decref(setup);
     json_decref(doc);
@@ -296,7 +293,7 @@ static vf_status after_step(const vf_attack_state *st, void *ctx)
 
 static vf_status optimize(attack_run *run, vf_attack_state *st)
 {
-    vf_status s = run->opt->resume ? load_checkpoint(run, st) : vf_attack_init(st, &run->cfg);
+    vf_status s = load_checkpoint(run, st);
     if (s != VF_OK)
         return s;
     run->attack_start = vf_now();
@@ -343,8 +340,8 @@ static vf_status attack_and_report(attack_run *run, json_t **result)
     vf_random_search_result baseline;
     vf_status s = ev ? VF_OK : vf_fail(VF_EINTERNAL, "out of memory");
     if (s == VF_OK)
-        s = run->opt->resume ? vf_stage_resume(run->ws, "attack", &run->stage)
-                             : vf_stage_begin(run->ws, "attack", &run->stage);
+        s = run->opt->restart ? vf_stage_begin(run->ws, "attack", &run->stage)
+                              : vf_stage_resume(run->ws, "attack", &run->stage);
     if (s == VF_OK && !random)
         s = optimize(run, &st);
     double t0 = vf_now();
@@ -418,8 +415,8 @@ vf_status vf_attack_run(vf_workspace *ws, const vf_attack_options *o, json_t **r
         s = restrict_space(&run);
     if (s == VF_OK)
         s = attack_and_report(&run, result);
-    /* A failure after the stage began leaves its staging folder (and checkpoint) for resume;
-     * the next run without resume clears it. */
+    /* A failure after the stage began leaves its staging folder (and checkpoint) for the
+     * next run (see the header's life cycle). */
     vf_view_loss_free(run.vl);
     vf_classifier_close(run.cls);
     vf_field_free(run.field);

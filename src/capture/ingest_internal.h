@@ -1,4 +1,4 @@
-/* src/ingest_internal.h (internal): what the three ingest sources (ingest_video.c,
+/* src/capture/ingest_internal.h (internal): what the three ingest sources (ingest_video.c,
  * ingest_photos.c, ingest_camera.c) share: a growing list of frame scores, writing frames,
  * and the parts of report.json that do not depend on the source. */
 #ifndef VF_INGEST_INTERNAL_H

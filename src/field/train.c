@@ -34,21 +34,6 @@ void vf_field_train_defaults(vf_field_train_options *opt)
     opt->threads = 0;
 }
 
-static const char *const surroundings_names[] = {"auto", "grid", "none"};
-
-const char *vf_field_surroundings_name(vf_field_surroundings s)
-{
-    return (unsigned)s < 3 ? surroundings_names[s] : "?";
-}
-
-int vf_field_surroundings_parse(const char *name)
-{
-    for (int i = 0; i < 3; i++)
-        if (!strcmp(name, surroundings_names[i]))
-            return i;
-    return -1;
-}
-
 static vf_status check_options(const vf_field_train_options *o)
 {
     if (!(o->seconds > 0) && o->steps <= 0)

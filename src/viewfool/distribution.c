@@ -1,4 +1,5 @@
-/* The viewpoint box, the tanh squashing and the entropy of the squashed Gaussian. */
+/* The viewpoint box, the tanh squashing, the entropy of the squashed Gaussian and the mixture
+ * weights and density. */
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -197,4 +198,43 @@ double vf_squashed_entropy(const vf_view_bounds *bounds, const double mu[VF_VIEW
             grad_sigma[i] = 1.0 / sigma[i] + d_sigma;
     }
     return h;
+}
+
+/* ---- mixtures ---- */
+
+void vf_attack_weights(const vf_attack_state *st, double *weights)
+{
+    double top = -INFINITY, sum = 0.0;
+    for (int c = 0; c < st->components; c++)
+        top = st->logit[c] > top ? st->logit[c] : top;
+    for (int c = 0; c < st->components; c++)
+        sum += weights[c] = exp(st->logit[c] - top);
+    for (int c = 0; c < st->components; c++)
+        weights[c] /= sum;
+}
+
+double vf__mixture_log_density(const vf_attack_state *st, const double u[VF_VIEW_DIM],
+                               double *resp)
+{
+    double pi[VF_ATTACK_MAX_COMPONENTS], logp[VF_ATTACK_MAX_COMPONENTS], top = -INFINITY;
+    vf_attack_weights(st, pi);
+    for (int c = 0; c < st->components; c++) {
+        double l = log(pi[c]);
+        for (int i = 0; i < VF_VIEW_DIM; i++) {
+            double z = (u[i] - st->mu[c][i]) / st->sigma[c][i];
+            l += -0.5 * z * z - log(st->sigma[c][i]) - 0.5 * log(2.0 * M_PI);
+        }
+        logp[c] = l;
+        if (l > top)
+            top = l;
+    }
+    /* log-sum-exp around the largest term */
+    double sum = 0.0;
+    for (int c = 0; c < st->components; c++)
+        sum += exp(logp[c] - top);
+    double log_density = top + log(sum);
+    if (resp)
+        for (int c = 0; c < st->components; c++)
+            resp[c] = exp(logp[c] - log_density);
+    return log_density;
 }

@@ -5,17 +5,6 @@
 
 #include "viewfool_internal.h"
 
-void vf_attack_weights(const vf_attack_state *st, double *weights)
-{
-    double top = -INFINITY, sum = 0.0;
-    for (int c = 0; c < st->components; c++)
-        top = st->logit[c] > top ? st->logit[c] : top;
-    for (int c = 0; c < st->components; c++)
-        sum += weights[c] = exp(st->logit[c] - top);
-    for (int c = 0; c < st->components; c++)
-        weights[c] /= sum;
-}
-
 void vf_attack_component_view(const vf_attack_state *st, const vf_attack_config *cfg, int c,
                               double v[VF_VIEW_DIM])
 {

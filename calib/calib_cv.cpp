@@ -1,4 +1,4 @@
-// The OpenCV side of the calibration (vf/calib.h, src/opencv/calib_cv.h): checkerboard
+// The OpenCV side of the calibration (vf/calib.h, calib/calib_cv.h): checkerboard
 // corners (ChArUco boards: charuco_cv.cpp), calibrateCamera, and rendering a textured plane
 // through a lens for synthetic views.
 // Pixel coordinates cross this boundary in the vf/camera.h convention (pixel centres at +0.5);

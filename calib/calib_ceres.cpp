@@ -1,7 +1,7 @@
-// Ceres bundle adjustment of a planar-board calibration (src/ceres/calib_refine.h): the OPENCV
+// Ceres bundle adjustment of a planar-board calibration (src/ceres/calib_ceres.h): the OPENCV
 // lens and every board pose, with a Huber loss so a few badly located corners cannot pull the
 // lens the way they pull OpenCV's plain least squares.
-#include "calib_refine.h"
+#include "calib_ceres.h"
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>

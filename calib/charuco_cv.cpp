@@ -1,4 +1,4 @@
-// ChArUco boards through OpenCV's aruco module (vf/calib.h, src/opencv/calib_cv.h): the
+// ChArUco boards through OpenCV's aruco module (vf/calib.h, calib/calib_cv.h): the
 // dictionary names, a printable board, and finding the corners a view shows. Pixel centres
 // cross this boundary at +0.5 (vf/camera.h); OpenCV puts them at integers.
 #include "vf/calib.h"
@@ -143,7 +143,7 @@ extern "C" vf_status vf_cv_find_charuco(const vf_rgb8 *frame, const vf_calib_boa
         cv::aruco::interpolateCornersCharuco(markers, marker_ids, gray, charuco, corners, ids);
         if ((int)ids.size() < VF_CHARUCO_MIN_CORNERS || !outer_quad(board, corners, ids, quad))
             return VF_OK;
-        int n = vf_calib_board_corners(board);
+        int n = board->cols * board->rows; /* inner corners, as vf_calib_board_corners */
         for (int i = 0; i < 2 * n; i++)
             uv[i] = NAN;
         for (size_t k = 0; k < ids.size(); k++) {

@@ -168,7 +168,9 @@ static vf_status stage_start(vf_workspace *ws, const char *stage, int keep, vf_s
     snprintf(s->name, sizeof s->name, "%s", stage);
     if (snprintf(s->dir, sizeof s->dir, "%s/.%s.partial", ws->root, stage) >= (int)sizeof s->dir)
         return vf_fail(VF_EINPUT, "workspace path too long: %s", ws->root);
-    /* What an interrupted run left: thrown away unless resuming. */
+    /* What an interrupted run left: thrown away unless resuming, and said so. */
+    if (!keep && vf_is_dir(s->dir) && !folder_is_empty(s->dir))
+        vf_info("%s: discarding what an interrupted run left in %s", stage, s->dir);
     vf_status status = keep ? VF_OK : vf_remove_tree(s->dir);
     if (status == VF_OK)
         status = vf_mkdirs(s->dir);

@@ -1,5 +1,5 @@
 // vfcapture's ONNX Runtime worker: loads one classifier with the npm package onnxruntime-node
-// and runs the batches that src/onnxruntime/classifier_ort.c sends it. Started as
+// and runs the batches that src/classify/classifier_ort.c sends it. Started as
 //
 //     node -e THIS_SCRIPT PACKAGE_DIR MODEL_PATH THREADS
 //

@@ -1,9 +1,9 @@
-/* src/localize_internal.h (internal): the pieces behind vf/localize.h.
+/* src/localize/localize_internal.h (internal): the pieces behind vf/localize.h.
  *
- *   localize_db.c             descriptors of the model's 3D points from COLMAP's database.db
- *   opencv/localize_cv.cpp    SIFT on a frame, nearest-neighbour index, PnP with RANSAC
- *   ceres/pose_refine.cpp     robust reprojection refinement of one pose
- *   localize.c                the flow, thresholds and frames
+ *   localize_db.c     descriptors of the model's 3D points from COLMAP's database.db
+ *   localize_cv.cpp   SIFT on a frame, nearest-neighbour index, PnP with RANSAC (OpenCV)
+ *   pose_ceres.cpp    robust reprojection refinement of one pose (Ceres)
+ *   localize.c        the flow, thresholds and frames
  *
  * Descriptors everywhere are 128 uint8 in COLMAP's convention (RootSIFT: L1-normalised,
  * square-rooted, times 512, clipped to 255), so a frame's features compare directly with

@@ -1,4 +1,4 @@
-/* src/oiio/image_oiio.h (internal): the OpenImageIO calls behind vf/image.h's files. A leaf:
+/* src/image/image_oiio.h (internal): the OpenImageIO calls behind vf/image.h's files. A leaf:
  * it moves raw interleaved float pixels between files and memory, and image.c makes vf_images
  * of them (applying the EXIF orientation it reports). */
 #ifndef VF_IMAGE_OIIO_H

@@ -1,4 +1,4 @@
-/* src/onnx_shape.h (internal): read a model's input shape straight from the ONNX file.
+/* src/classify/onnx_shape.h (internal): read a model's input shape straight from the ONNX file.
  * OpenCV 4.6 does not report the input shape of a loaded network, so we walk the protobuf:
  * ModelProto.graph -> GraphProto.input (minus initializers) -> type.tensor_type.shape.dim. */
 #ifndef VF_ONNX_SHAPE_H

@@ -1,4 +1,4 @@
-/* src/opencv/classifier_dnn.h (internal): the OpenCV dnn calls behind vf/classifier.h.
+/* src/classify/classifier_dnn.h (internal): the OpenCV dnn calls behind vf/classifier.h.
  * An ONNX network loaded once and run on CPU batches; not re-entrant (one thread at a time). */
 #ifndef VF_CLASSIFIER_DNN_H
 #define VF_CLASSIFIER_DNN_H

@@ -1,7 +1,7 @@
 /* Localizing frames against a workspace's sparse model (vf/localize.h): the flow, the camera
  * for a frame, the acceptance thresholds and the frames the pose is reported in. The feature,
- * matching and PnP calls are in opencv/localize_cv.cpp, the refinement in
- * ceres/pose_refine.cpp, the descriptors' source in localize_db.c. */
+ * matching and PnP calls are in localize_cv.cpp, the refinement in
+ * pose_ceres.cpp, the descriptors' source in localize_db.c. */
 #include "vf/localize.h"
 
 #include <jansson.h>

@@ -1,4 +1,4 @@
-/* src/opencv/calib_cv.h: OpenCV's camera calibration, for calib/ (internal to the library).
+/* calib/calib_cv.h: OpenCV's camera calibration, for calib/ (internal to the library).
  *
  * Board corners lie on z = 0 at object_xy (2 per corner); uv[v] holds view v's 2 * corners
  * pixel positions (vf/camera.h convention), NaN for corners the view did not see. Poses are

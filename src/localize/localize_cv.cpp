@@ -1,7 +1,7 @@
 // The OpenCV side of localization (src/localize_internal.h): SIFT features of a frame in
 // COLMAP's descriptor convention, a FLANN index over the map's descriptors, and PnP with
 // RANSAC. Every cv::Exception becomes a vf_status with one line.
-#include "../localize_internal.h"
+#include "localize_internal.h"
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>

@@ -1,10 +1,10 @@
-/* src/ceres/calib_refine.h: Ceres refinement of a calibration (internal to the library).
+/* calib/calib_ceres.h: Ceres refinement of a calibration (internal to the library).
  *
- * Same layout as src/opencv/calib_cv.h: board corners at object_xy on z = 0, uv[v] the
+ * Same layout as calib/calib_cv.h: board corners at object_xy on z = 0, uv[v] the
  * pixels of view v, poses 6 doubles per view (rotation vector, translation; board -> camera,
  * OpenCV axes). */
-#ifndef VF_CALIB_REFINE_H
-#define VF_CALIB_REFINE_H
+#ifndef VF_CALIB_CERES_H
+#define VF_CALIB_CERES_H
 
 #include "vf/camera.h"
 #include "vf/error.h"

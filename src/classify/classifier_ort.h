@@ -1,4 +1,4 @@
-/* src/onnxruntime/classifier_ort.h (internal): the ONNX Runtime engine behind vf/classifier.h.
+/* src/classify/classifier_ort.h (internal): the ONNX Runtime engine behind vf/classifier.h.
  *
  * Debian has no ONNX Runtime package and the npm one (onnxruntime-node, which scripts/setup.sh
  * installs) has no C headers, so the model runs in a worker process of the project's own

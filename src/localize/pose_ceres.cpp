@@ -2,7 +2,7 @@
 // and the lens are fixed, the world-to-camera rotation (angle-axis) and translation move to
 // minimise the reprojection error in pixels through the full OPENCV lens, each residual under
 // a Cauchy loss so that outlier matches lose their pull instead of bending the pose.
-#include "../localize_internal.h"
+#include "localize_internal.h"
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "oiio/image_oiio.h"
+#include "image_oiio.h"
 #include "vf/fsutil.h"
 
 vf_status vf_image_alloc(vf_image *img, int width, int height, int channels)

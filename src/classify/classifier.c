@@ -1,6 +1,6 @@
 /* The plain-C half of vf/classifier.h: choosing the engine, preprocessing, softmax, top-k,
  * class names and label sets. The network itself runs in onnxruntime/classifier_ort.c (a
- * worker process) or opencv/classifier_dnn.cpp. */
+ * worker process) or classifier_dnn.cpp. */
 #define _GNU_SOURCE /* strdup, strtok_r, strncasecmp */
 #include "vf/classifier.h"
 
@@ -12,9 +12,9 @@
 #include <string.h>
 #include <strings.h>
 
+#include "classifier_dnn.h"
+#include "classifier_ort.h"
 #include "onnx_shape.h"
-#include "onnxruntime/classifier_ort.h"
-#include "opencv/classifier_dnn.h"
 #include "vf/fsutil.h"
 #include "vf/log.h"
 #include "vf/resources.h"
