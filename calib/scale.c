@@ -64,11 +64,6 @@ static vf_status triangulate(const vf_dataset *ds, const sightings *s, double X[
     return status;
 }
 
-static json_t *point_json(const double X[3])
-{
-    return json_pack("[f, f, f]", X[0], X[1], X[2]);
-}
-
 static double distance3(const double *a, const double *b)
 {
     return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
@@ -153,7 +148,7 @@ vf_status vf_scale_from_marker(const vf_workspace *ws, int id, double size_m,
         *metres_per_unit = size_m / mean;
         json_t *points = json_array(), *sides = json_array(), *errors = json_array();
         for (int k = 0; k < 4; k++) {
-            json_array_append_new(points, point_json(X[k]));
+            json_array_append_new(points, vf_json_doubles(X[k], 3));
             json_array_append_new(sides, json_real(side[k]));
             json_array_append_new(errors, json_real(residual[k]));
         }
@@ -233,8 +228,8 @@ vf_status vf_scale_from_picks(const vf_workspace *ws, const vf_pick *p1, int n1,
                                     "different points");
     if (status == VF_OK) {
         *metres_per_unit = distance_m / units;
-        *details = json_pack("{s:f, s:[o, o], s:f, s:[f, f]}", "distance_m", distance_m,
-                             "points", point_json(X[0]), point_json(X[1]), "distance_units",
+        *details = json_pack("{s:f, s:[o, o], s:f, s:[f, f]}", "distance_m", distance_m, "points",
+                             vf_json_doubles(X[0], 3), vf_json_doubles(X[1], 3), "distance_units",
                              units, "reprojection_px", residual[0], residual[1]);
     }
     sightings_free(&s[0]);

@@ -43,12 +43,12 @@ static vf_status parse_options(int argc, char **argv, render_options *opt)
     };
     int c;
     long size;
-    double v[VF_VIEWPOINT_DIMS];
+    double v[VF_VIEW_DIM];
     while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "o:", longopts, NULL)) != -1) {
         if (cli_common_option(c, &opt->flags, "render", usage))
             continue;
         if (c == OPT_VIEWPOINT) {
-            if (cli_parse_doubles(optarg, v, VF_VIEWPOINT_DIMS) != VF_VIEWPOINT_DIMS)
+            if (cli_parse_doubles(optarg, v, VF_VIEW_DIM) != VF_VIEW_DIM)
                 return vf_fail(VF_EINPUT, "--viewpoint needs 6 numbers psi,theta,phi,dx,dy,dz, "
                                           "not '%s'", optarg);
             vf_viewpoint p = vf_viewpoint_from_array(v);

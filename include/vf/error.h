@@ -38,6 +38,23 @@ const char *vf_error_message(void);
 
 void vf_error_clear(void);
 
+/* A worker thread's error, carried out of a parallel loop. Messages are per thread, so the
+ * first failure's status and message are kept here and raised again on the caller's thread:
+ *
+ *     vf_first_error first = {0};
+ *     #pragma omp parallel for
+ *     for (int i = 0; i < n; i++)
+ *         vf_first_error_keep(&first, work(i));   // VF_OK is ignored; thread-safe
+ *     return vf_first_error_raise(&first);        // VF_OK, or the first failure again
+ */
+typedef struct vf_first_error {
+    vf_status status;
+    char message[1024];
+} vf_first_error;
+
+void vf_first_error_keep(vf_first_error *e, vf_status s);
+vf_status vf_first_error_raise(const vf_first_error *e);
+
 #ifdef __cplusplus
 }
 #endif

@@ -128,7 +128,7 @@ vf_status vf_similarity_umeyama(const double *src, const double *dst, int n, vf_
 /* ---- the ViewFool viewpoint ---- */
 
 #define VF_CAMERA_DISTANCE 4.0 /* nominal camera distance to the object, scene units */
-#define VF_VIEWPOINT_DIMS 6
+#define VF_VIEW_DIM 6          /* psi, theta, phi, dx, dy, dz: a viewpoint as an array */
 
 /* Degrees for the angles, scene units for the offsets; array order is the field order. */
 typedef struct vf_viewpoint {
@@ -142,8 +142,8 @@ void vf_viewpoint_to_c2w(const vf_viewpoint *v, double c2w[16]);
  * (-180, 180] (so psi = -180 returns as 180) and phi in (-90, 270]. */
 void vf_c2w_to_viewpoint(const double c2w[16], vf_viewpoint *out);
 
-void vf_viewpoint_to_array(const vf_viewpoint *v, double a[VF_VIEWPOINT_DIMS]);
-vf_viewpoint vf_viewpoint_from_array(const double a[VF_VIEWPOINT_DIMS]);
+void vf_viewpoint_to_array(const vf_viewpoint *v, double a[VF_VIEW_DIM]);
+vf_viewpoint vf_viewpoint_from_array(const double a[VF_VIEW_DIM]);
 
 #ifdef __cplusplus
 }

@@ -40,13 +40,13 @@
 #include <stdint.h>
 
 #include "vf/error.h"
+#include "vf/pose.h"
 #include "vf/rng.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define VF_VIEW_DIM 6              /* psi, theta, phi, dx, dy, dz */
 #define VF_ATTACK_MAX_COMPONENTS 8 /* largest mixture K */
 /* Per component: mu[6], sigma[6], one mixture logit. */
 #define VF_ATTACK_COMPONENT_PARAMS (2 * VF_VIEW_DIM + 1)

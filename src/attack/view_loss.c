@@ -87,10 +87,14 @@ static vf_status classify_chunk(vf_view_loss *vl, const vf_image *images, int n,
 {
     double t0 = vf_now();
     size_t stride = 3 * (size_t)vl->size * (size_t)vl->size;
+    vf_first_error error = {0}; /* a worker's failure was dropped here before */
 #pragma omp parallel for
     for (int i = 0; i < n; i++)
-        vf_classifier_normalize(&images[i], vl->batch + (size_t)i * stride);
-    vf_status status = vf_classifier_logits(vl->cls, vl->batch, n, vl->logits);
+        vf_first_error_keep(&error,
+                            vf_classifier_normalize(&images[i], vl->batch + (size_t)i * stride));
+    vf_status status = vf_first_error_raise(&error);
+    if (status == VF_OK)
+        status = vf_classifier_logits(vl->cls, vl->batch, n, vl->logits);
     if (status != VF_OK)
         return status;
     for (int i = 0; i < n; i++)

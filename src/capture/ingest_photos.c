@@ -42,8 +42,7 @@ static vf_status list_photos(const char *folder, photo_list *list)
 static vf_status score_photos(const char *folder, photo_list *list, score_list *scores,
                               int *sizes)
 {
-    vf_status status = VF_OK;
-    char message[1024] = ""; /* error messages are per thread: carry the first one out */
+    vf_first_error error = {0};
     int done = 0;
     vf_progress progress;
     vf_progress_begin(&progress, "scoring photos", (size_t)list->count, "photos");
@@ -65,17 +64,12 @@ static vf_status score_photos(const char *folder, photo_list *list, score_list *
             sizes[2 * i + 1] = photo.height;
         }
         vf_rgb8_free(&photo);
+        vf_first_error_keep(&error, s);
 #pragma omp critical
-        {
-            if (s != VF_OK && status == VF_OK) {
-                status = s;
-                snprintf(message, sizeof message, "%s", vf_error_message());
-            }
-            vf_progress_update(&progress, (size_t)++done, NULL);
-        }
+        vf_progress_update(&progress, (size_t)++done, NULL);
     }
     vf_progress_end(&progress);
-    return status == VF_OK ? VF_OK : vf_fail(status, "%s", message);
+    return vf_first_error_raise(&error);
 }
 
 /* The name a photo is written under: its index (unique even if names repeat) and stem. */
@@ -114,8 +108,7 @@ static vf_status save_with_alpha(const char *path, const char *images_dir, const
 static vf_status write_photos(const char *folder, const photo_list *list, const vf_selection *sel,
                               int max_size, const char *images_dir, int *width, int *height)
 {
-    vf_status status = VF_OK;
-    char message[1024] = "";
+    vf_first_error error = {0};
 #pragma omp parallel for schedule(dynamic)
     for (int k = 0; k < sel->chosen_count; k++) {
         int i = sel->chosen[k];
@@ -130,13 +123,9 @@ static vf_status write_photos(const char *folder, const photo_list *list, const 
             s = vf__ingest_save_frame(images_dir, name, &photo, max_size, k ? NULL : width,
                                       k ? NULL : height);
         vf_rgb8_free(&photo);
-#pragma omp critical
-        if (s != VF_OK && status == VF_OK) {
-            status = s;
-            snprintf(message, sizeof message, "%s", vf_error_message());
-        }
+        vf_first_error_keep(&error, s);
     }
-    return status == VF_OK ? VF_OK : vf_fail(status, "%s", message);
+    return vf_first_error_raise(&error);
 }
 
 /* Photo names and sizes, and how many are portrait or landscape (warning when mixed: later

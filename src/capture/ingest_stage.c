@@ -52,8 +52,7 @@ void vf_ingest_request_defaults(vf_ingest_request *r)
  * in one line. */
 static vf_status check_images(const vf_dataset *ds, int *has_alpha)
 {
-    vf_status status = VF_OK;
-    char message[1024] = ""; /* error messages are per thread: carry the first one out */
+    vf_first_error error = {0};
     int alpha = 0, done = 0;
     int show = ds->count >= 64;
     vf_progress progress;
@@ -69,20 +68,15 @@ static vf_status check_images(const vf_dataset *ds, int *has_alpha)
             alpha |= img.channels == 4;
             vf_image_free(&img);
         }
+        vf_first_error_keep(&error, s);
 #pragma omp critical
-        {
-            if (s != VF_OK && status == VF_OK) {
-                status = s;
-                snprintf(message, sizeof message, "%s", vf_error_message());
-            }
-            if (show)
-                vf_progress_update(&progress, (size_t)++done, NULL);
-        }
+        if (show)
+            vf_progress_update(&progress, (size_t)++done, NULL);
     }
     if (show)
         vf_progress_end(&progress);
     *has_alpha = alpha;
-    return status == VF_OK ? VF_OK : vf_fail(status, "%s", message);
+    return vf_first_error_raise(&error);
 }
 
 /* Copy the images into the staging folder; `copy` gets the new paths. */

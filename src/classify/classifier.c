@@ -299,20 +299,15 @@ static vf_status preprocess_batch(const vf_image *images, int first, int n, int 
                                   float *batch)
 {
     size_t stride = 3 * (size_t)size * (size_t)size;
-    vf_status status = VF_OK;
-    char message[1024] = "";
+    vf_first_error error = {0};
 #pragma omp parallel for schedule(dynamic)
     for (int i = 0; i < n; i++) {
         vf_status s = vf_classifier_preprocess(&images[i], size, batch + (size_t)i * stride);
-        if (s != VF_OK) {
-#pragma omp critical(vf_preprocess_error)
-            if (status == VF_OK) {
-                status = s;
-                snprintf(message, sizeof message, "image %d: %s", first + i, vf_error_message());
-            }
-        }
+        if (s != VF_OK)
+            vf_error_prefix("image %d", first + i);
+        vf_first_error_keep(&error, s);
     }
-    return status == VF_OK ? VF_OK : vf_fail(status, "%s", message);
+    return vf_first_error_raise(&error);
 }
 
 vf_status vf_classifier_classify_images(vf_classifier *cls, const vf_image *images, int n,

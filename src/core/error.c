@@ -35,3 +35,19 @@ void vf_error_prefix(const char *fmt, ...)
 const char *vf_error_message(void) { return error_text; }
 
 void vf_error_clear(void) { error_text[0] = '\0'; }
+
+void vf_first_error_keep(vf_first_error *e, vf_status s)
+{
+    if (s == VF_OK)
+        return;
+#pragma omp critical(vf_first_error)
+    if (e->status == VF_OK) {
+        e->status = s;
+        snprintf(e->message, sizeof e->message, "%s", vf_error_message());
+    }
+}
+
+vf_status vf_first_error_raise(const vf_first_error *e)
+{
+    return e->status == VF_OK ? VF_OK : vf_fail(e->status, "%s", e->message);
+}

@@ -516,13 +516,13 @@ void vf_c2w_to_viewpoint(const double c2w[16], vf_viewpoint *out)
     out->dy = local[2] - VF_CAMERA_DISTANCE;
 }
 
-void vf_viewpoint_to_array(const vf_viewpoint *v, double a[VF_VIEWPOINT_DIMS])
+void vf_viewpoint_to_array(const vf_viewpoint *v, double a[VF_VIEW_DIM])
 {
     a[0] = v->psi, a[1] = v->theta, a[2] = v->phi;
     a[3] = v->dx, a[4] = v->dy, a[5] = v->dz;
 }
 
-vf_viewpoint vf_viewpoint_from_array(const double a[VF_VIEWPOINT_DIMS])
+vf_viewpoint vf_viewpoint_from_array(const double a[VF_VIEW_DIM])
 {
     vf_viewpoint v = {a[0], a[1], a[2], a[3], a[4], a[5]};
     return v;

@@ -85,23 +85,18 @@ vf_status vf_sfm_save_points(const char *path, const vf_colmap_model *model,
     return status;
 }
 
-static json_t *vec3_json(const double v[3])
-{
-    return json_pack("[f,f,f]", v[0], v[1], v[2]);
-}
-
 static json_t *similarity_json(const vf_similarity *s)
 {
     double m[16];
     vf_similarity_to_mat4(s, m);
     json_t *rotation = json_array(), *matrix = json_array();
     for (int r = 0; r < 3; r++)
-        json_array_append_new(rotation, vec3_json(s->R + 3 * r));
+        json_array_append_new(rotation, vf_json_doubles(s->R + 3 * r, 3));
     for (int r = 0; r < 4; r++)
         json_array_append_new(matrix, json_pack("[f,f,f,f]", m[4 * r], m[4 * r + 1],
                                                 m[4 * r + 2], m[4 * r + 3]));
     return json_pack("{s:f, s:o, s:o, s:o}", "scale", s->scale, "rotation", rotation,
-                     "translation", vec3_json(s->t), "matrix", matrix);
+                     "translation", vf_json_doubles(s->t, 3), "matrix", matrix);
 }
 
 vf_status vf_sfm_save_normalization(const char *path, const vf_normalization *norm)
@@ -112,11 +107,10 @@ vf_status vf_sfm_save_normalization(const char *path, const vf_normalization *no
         "x_to = scale * rotation * x_from + translation (matrix: the same as a 4x4); the object "
         "frame has z up, the object at the origin and cameras at a mean distance of 4",
         "object_from_colmap", similarity_json(&norm->object_from_world), "colmap_from_object",
-        similarity_json(&inverse), "up_colmap", vec3_json(norm->up_world), "up_method",
-        norm->up_method, "center_colmap",
-        vec3_json(norm->center_world), "center_method", norm->center_method,
-        "colmap_mean_camera_distance", norm->world_distance, "object_mean_camera_distance",
-        norm->world_distance * norm->object_from_world.scale);
+        similarity_json(&inverse), "up_colmap", vf_json_doubles(norm->up_world, 3), "up_method",
+        norm->up_method, "center_colmap", vf_json_doubles(norm->center_world, 3), "center_method",
+        norm->center_method, "colmap_mean_camera_distance", norm->world_distance,
+        "object_mean_camera_distance", norm->world_distance * norm->object_from_world.scale);
     if (!doc)
         return vf_fail(VF_EINTERNAL, "cannot encode %s", path);
     vf_status status = vf_json_save(path, doc);

@@ -99,8 +99,7 @@ static void name_frame(vf_sfm_frame *f, int grouped)
 static vf_status place_frames(vf_sfm_images *images, const char *dst_dir,
                               const float background[3])
 {
-    vf_status status = VF_OK;
-    char message[1024] = "";
+    vf_first_error error = {0};
     double share_sum = 0;
     int alpha = 0, done = 0;
     vf_progress progress;
@@ -118,19 +117,14 @@ static vf_status place_frames(vf_sfm_images *images, const char *dst_dir,
             s = place_frame(f, &img, dst_dir, background);
             vf_image_free(&img);
         }
+        vf_first_error_keep(&error, s);
 #pragma omp critical
-        {
-            if (s != VF_OK && status == VF_OK) {
-                status = s;
-                snprintf(message, sizeof message, "%s", vf_error_message());
-            }
-            vf_progress_update(&progress, (size_t)++done, NULL);
-        }
+        vf_progress_update(&progress, (size_t)++done, NULL);
     }
     vf_progress_end(&progress);
     images->with_alpha = alpha;
     images->background_fraction = share_sum / images->count;
-    return status == VF_OK ? VF_OK : vf_fail(status, "%s", message);
+    return vf_first_error_raise(&error);
 }
 
 vf_status vf_sfm_images_prepare(const char *src_dir, const char *dst_dir,
