@@ -54,37 +54,26 @@ typedef struct run_options {
     cli_flags flags;
 } run_options;
 
-/* One stage: its name, how to run it, and the settings run.json remembers it by. */
+/* One stage: its name, which it is, and the settings run.json remembers it by. */
 typedef struct stage_call {
     const char *name;
-    vf_status (*run)(vf_workspace *ws, const run_options *o, json_t **out);
+    int which;
     json_t *settings;
 } stage_call;
 
-/* The stages as run calls them; *out is the stage's result document. */
-static vf_status ingest(vf_workspace *ws, const run_options *o, json_t **out)
+enum { INGEST, POSES, TRAIN, ATTACK, REAL, EXPORT };
+
+/* Stage `which` as run calls it; *out is the stage's result document. */
+static vf_status call_stage(int which, vf_workspace *ws, const run_options *o, json_t **out)
 {
-    return vf_ingest_run(ws->root, &o->ingest, out);
-}
-static vf_status poses(vf_workspace *ws, const run_options *o, json_t **out)
-{
-    return vf_poses_run(ws, &o->poses, out);
-}
-static vf_status train(vf_workspace *ws, const run_options *o, json_t **out)
-{
-    return vf_train_run(ws, &o->train, out);
-}
-static vf_status attack(vf_workspace *ws, const run_options *o, json_t **out)
-{
-    return vf_attack_run(ws, &o->attack, out);
-}
-static vf_status real(vf_workspace *ws, const run_options *o, json_t **out)
-{
-    return vf_real_run(ws, &o->real, out);
-}
-static vf_status export_targets(vf_workspace *ws, const run_options *o, json_t **out)
-{
-    return vf_export_run(ws, &o->export_, out);
+    switch (which) {
+    case INGEST: return vf_ingest_run(ws->root, &o->ingest, out);
+    case POSES: return vf_poses_run(ws, &o->poses, out);
+    case TRAIN: return vf_train_run(ws, &o->train, out);
+    case ATTACK: return vf_attack_run(ws, &o->attack, out);
+    case REAL: return vf_real_run(ws, &o->real, out);
+    default: return vf_export_run(ws, &o->export_, out);
+    }
 }
 
 static json_t *text_or_null(const char *text) { return text ? json_string(text) : json_null(); }
@@ -96,21 +85,21 @@ static int plan_stages(const run_options *o, stage_call *calls)
     const vf_ingest_options *cap = &o->ingest.capture;
     int n = 0;
     calls[n++] =
-        (stage_call){"ingest", ingest,
+        (stage_call){"ingest", INGEST,
                      json_pack("{s:s, s:s, s:i}", "input", o->ingest.input, "kind",
                                vf_ingest_kind_name(kind), "frames", cap->select.max_frames)};
     if (kind != VF_INGEST_TRANSFORMS && kind != VF_INGEST_MODEL)
-        calls[n++] = (stage_call){"poses", poses, json_object()};
+        calls[n++] = (stage_call){"poses", POSES, json_object()};
     calls[n++] = (stage_call){
-        "train", train,
+        "train", TRAIN,
         json_pack("{s:f, s:i}", "minutes", o->train.minutes, "steps", o->train.steps)};
-    calls[n++] = (stage_call){"attack", attack,
+    calls[n++] = (stage_call){"attack", ATTACK,
                               json_pack("{s:s, s:o, s:i, s:i}", "model", o->attack.model, "label",
                                         text_or_null(o->attack.label), "samples",
                                         o->attack.samples, "steps", o->attack.steps)};
     if (kind == VF_INGEST_MODEL) /* posed by Blender; the attack checked on the object */
-        calls[n++] = (stage_call){"real", real, json_object()};
-    calls[n++] = (stage_call){"export", export_targets, json_object()};
+        calls[n++] = (stage_call){"real", REAL, json_object()};
+    calls[n++] = (stage_call){"export", EXPORT, json_object()};
     return n;
 }
 
@@ -238,7 +227,7 @@ static vf_status run_stages(vf_workspace *ws, const run_options *o, stage_call *
         vf_info("== stage %d of %d: %s ==", i + 1, count, calls[i].name);
         double start = vf_now();
         json_t *result = NULL;
-        s = calls[i].run(ws, o, &result);
+        s = call_stage(calls[i].which, ws, o, &result);
         json_decref(result);
         vf_workspace_close(ws);
         vf_status reopened = vf_workspace_open(o->workspace, 0, ws);

@@ -139,6 +139,21 @@ int main(void)
         CHECK(json_array_size(json_object_get(json_object_get(real, "fluctuation"), side)) == 10,
               "%s fluctuation curve of 10 levels", side);
     }
+    /* score --summary tabulates the object's columns beside the rendered ones (no physical
+     * re-capture here: its columns are left empty) */
+    char summary[8192];
+    snprintf(summary, sizeof summary, "%s/summary.json", dir);
+    rc = vf_test_system("'%s' score --summary '%s' --json >'%s'", tool(), ws, summary);
+    json_t *rows = load(dir, "summary.json");
+    const json_t *row = json_array_get(json_object_get(rows, "rows"), 0);
+    CHECK(rc == 0 && row != NULL, "score --summary on a model's workspace (exit %d)", rc);
+    CHECK(fabs(number(row, "real_asr_samples", NULL) - number(real, "asr_samples", "real")) <
+                  1e-9 &&
+              fabs(number(row, "real_natural_accuracy", NULL) - nat_real) < 1e-9 &&
+              !json_object_get(row, "physical_asr"),
+          "the summary row carries Real(p*(v)) %.2f and the object's natural accuracy %.2f",
+          number(row, "real_asr_samples", NULL), number(row, "real_natural_accuracy", NULL));
+    json_decref(rows);
     json_decref(real);
     snprintf(ws, sizeof ws, "%s/ws/real/sheet.png", dir);
     CHECK(vf_is_file(ws), "the contact sheet %s", ws);
