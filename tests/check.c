@@ -45,10 +45,41 @@ int vf_test_system(const char *fmt, ...)
     return status == -1 ? -1 : WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+static char **filters;
+static int filter_count, listing, matched;
+
+void check_args(int argc, char **argv)
+{
+    listing = argc > 1 && !strcmp(argv[1], "--list");
+    filters = argv + 1;
+    filter_count = listing ? 0 : argc - 1;
+}
+
+int check_case(const char *name)
+{
+    if (listing) {
+        printf("%s\n", name);
+        return 0;
+    }
+    for (int i = 0; i < filter_count; i++)
+        if (strstr(name, filters[i])) {
+            matched++;
+            printf("== %s\n", name);
+            return 1;
+        }
+    return filter_count == 0;
+}
+
 int check_finish(void)
 {
     if (tmpdir[0] && !getenv("VF_KEEP_TMP"))
         vf_remove_tree(tmpdir);
+    if (listing)
+        return 0;
+    if (filter_count > 0 && matched == 0) {
+        fprintf(stderr, "no case matches '%s' (--list names them)\n", filters[0]);
+        return 1;
+    }
     printf("%d passed, %d failed\n", check_passed, check_failed);
     return check_failed ? 1 : 0;
 }

@@ -2,8 +2,11 @@
  *
  * CHECK(cond, ...) records a failure with a message and carries on; CHECK_NEAR compares
  * numbers with a tolerance. check_finish() prints "N passed, N failed" and returns the exit
- * code. vf_test_shared(rel) gives a path under ../shared (or $VF_SHARED_DIR); vf_test_tmpdir()
- * makes a fresh scratch folder for the test. */
+ * code. Named cases: main calls check_args(argc, argv) and runs each case through
+ * CHECK_CASE(test_resume); `build/test_viewfool resume` then runs only the cases whose name
+ * contains "resume" (several words: any of them), `--list` prints the names, and a filter that
+ * matches nothing fails. vf_test_shared(rel) gives a path under ../shared (or $VF_SHARED_DIR);
+ * vf_test_tmpdir() makes a fresh scratch folder for the test. */
 #ifndef VF_TEST_CHECK_H
 #define VF_TEST_CHECK_H
 
@@ -35,6 +38,15 @@ const char *vf_test_tmpdir(void);
 /* Run a shell command, return its exit status (-1 when it could not run). */
 int vf_test_system(const char *fmt, ...);
 int check_finish(void);
+
+void check_args(int argc, char **argv);
+/* Whether the case `name` runs under the filter (and says so when filtered). */
+int check_case(const char *name);
+#define CHECK_CASE(fn)                                                                            \
+    do {                                                                                          \
+        if (check_case(#fn))                                                                      \
+            fn();                                                                                 \
+    } while (0)
 
 /* A radiance field trained for `steps` steps (no time limit, so a busy machine gives the same
  * field) on the first `views` frames of ds (all when 0), at most max_points grid points. NULL

@@ -346,12 +346,13 @@ static void test_scale(void)
     vf_dataset_free(&ds);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    check_args(argc, argv);
     vf_log_set_quiet(1);
-    test_picks_parse();
-    test_intrinsics();
-    test_charuco();
-    test_scale();
+    CHECK_CASE(test_picks_parse);
+    CHECK_CASE(test_intrinsics);
+    CHECK_CASE(test_charuco);
+    CHECK_CASE(test_scale);
     return check_finish();
 }

@@ -184,12 +184,13 @@ static void test_camera_file(void)
     }
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_camera_file();
-    test_intrinsics();
-    test_distort_hand_worked();
-    test_undistort();
-    test_pixel_ray();
+    check_args(argc, argv);
+    CHECK_CASE(test_camera_file);
+    CHECK_CASE(test_intrinsics);
+    CHECK_CASE(test_distort_hand_worked);
+    CHECK_CASE(test_undistort);
+    CHECK_CASE(test_pixel_ray);
     return check_finish();
 }

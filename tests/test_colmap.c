@@ -177,12 +177,13 @@ static void test_runner(const char *dir)
     vf_args_free(&args);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    check_args(argc, argv);
     const char *dir = vf_test_tmpdir();
     vf_log_set_quiet(1);
     test_model(dir);
-    test_progress_lines();
+    CHECK_CASE(test_progress_lines);
     test_runner(dir);
     return check_finish();
 }

@@ -263,15 +263,16 @@ static void test_engines_agree(void)
         vf_image_free(&images[i]);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    check_args(argc, argv);
     vf_log_set_quiet(1);
-    test_names_and_topk();
-    test_label_sets();
-    test_bad_models();
-    test_small_model();
-    test_size_from_graph();
-    test_accuracy();
-    test_engines_agree();
+    CHECK_CASE(test_names_and_topk);
+    CHECK_CASE(test_label_sets);
+    CHECK_CASE(test_bad_models);
+    CHECK_CASE(test_small_model);
+    CHECK_CASE(test_size_from_graph);
+    CHECK_CASE(test_accuracy);
+    CHECK_CASE(test_engines_agree);
     return check_finish();
 }

@@ -210,8 +210,9 @@ static void test_errors(void)
     free(saved);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    check_args(argc, argv);
     vf_log_set_quiet(1);
     if (vf_engine_check(VF_ENGINE_ONNXRUNTIME) != VF_OK) {
         CHECK(0, "%s", vf_error_message());
@@ -224,8 +225,8 @@ int main(void)
     CHECK(rc == 0, "tests/onnx_ops.py failed (%d): python3-onnx installed?", rc);
     if (rc != 0)
         return check_finish();
-    test_graphs();
-    test_errors();
-    test_attack_steps();
+    CHECK_CASE(test_graphs);
+    CHECK_CASE(test_errors);
+    CHECK_CASE(test_attack_steps);
     return check_finish();
 }

@@ -275,17 +275,18 @@ static void test_mixed_orientation(void)
     json_decref(report);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    check_args(argc, argv);
     vf_log_set_quiet(1);
     snprintf(tmp, sizeof tmp, "%s", vf_test_tmpdir());
     list_fox_photos();
     CHECK(photo_count == 50, "50 fox photos, found %d", photo_count);
     if (photo_count != 50)
         return check_finish();
-    test_rotated_video();
-    test_blurred_and_still_frames();
-    test_photo_folder();
-    test_mixed_orientation();
+    CHECK_CASE(test_rotated_video);
+    CHECK_CASE(test_blurred_and_still_frames);
+    CHECK_CASE(test_photo_folder);
+    CHECK_CASE(test_mixed_orientation);
     return check_finish();
 }

@@ -591,18 +591,19 @@ static void test_empty_radius(void)
     vf__field_grid_free(&g);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_fast_math();
-    test_alpha_table();
-    test_empty_radius();
+    check_args(argc, argv);
+    CHECK_CASE(test_fast_math);
+    CHECK_CASE(test_alpha_table);
+    CHECK_CASE(test_empty_radius);
     test_gradients(0);
     test_gradients(0.7f);
-    test_render_matches_march();
-    test_jumps_skip_only_empty();
-    test_model_files();
-    test_hostile_models();
-    test_adam_small_team();
-    test_checkpoint_resume();
+    CHECK_CASE(test_render_matches_march);
+    CHECK_CASE(test_jumps_skip_only_empty);
+    CHECK_CASE(test_model_files);
+    CHECK_CASE(test_hostile_models);
+    CHECK_CASE(test_adam_small_team);
+    CHECK_CASE(test_checkpoint_resume);
     return check_finish();
 }

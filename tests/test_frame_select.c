@@ -191,11 +191,12 @@ static void test_live_counter(void)
     free(s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_sharpness();
-    test_selection();
-    test_unordered();
-    test_live_counter();
+    check_args(argc, argv);
+    CHECK_CASE(test_sharpness);
+    CHECK_CASE(test_selection);
+    CHECK_CASE(test_unordered);
+    CHECK_CASE(test_live_counter);
     return check_finish();
 }

@@ -331,19 +331,20 @@ static void test_exif_orientation(void)
     vf_image_free(&img);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_png_round_trip();
-    test_exr_round_trip();
-    test_jpeg_drops_alpha();
-    test_alpha_compositing();
-    test_grey_expands();
-    test_resize_constant();
-    test_resize_gradient();
-    test_center_crop();
-    test_reorient();
-    test_exif_orientation();
-    test_errors();
-    test_real_frame();
+    check_args(argc, argv);
+    CHECK_CASE(test_png_round_trip);
+    CHECK_CASE(test_exr_round_trip);
+    CHECK_CASE(test_jpeg_drops_alpha);
+    CHECK_CASE(test_alpha_compositing);
+    CHECK_CASE(test_grey_expands);
+    CHECK_CASE(test_resize_constant);
+    CHECK_CASE(test_resize_gradient);
+    CHECK_CASE(test_center_crop);
+    CHECK_CASE(test_reorient);
+    CHECK_CASE(test_exif_orientation);
+    CHECK_CASE(test_errors);
+    CHECK_CASE(test_real_frame);
     return check_finish();
 }

@@ -108,10 +108,11 @@ static void test_parallel_axes(void)
     CHECK(vf_normalize_scene(c2w, 1, NULL, 0, &norm) == VF_EINPUT, "one camera");
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_full_ring();
-    test_arc_looking_down();
-    test_parallel_axes();
+    check_args(argc, argv);
+    CHECK_CASE(test_full_ring);
+    CHECK_CASE(test_arc_looking_down);
+    CHECK_CASE(test_parallel_axes);
     return check_finish();
 }

@@ -35,8 +35,9 @@ static void test_capture_poses(void)
     free(c2w);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_capture_poses();
+    check_args(argc, argv);
+    CHECK_CASE(test_capture_poses);
     return check_finish();
 }

@@ -135,9 +135,10 @@ static void test_many_inputs(void)
     free(model.data);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_small();
-    test_many_inputs();
+    check_args(argc, argv);
+    CHECK_CASE(test_small);
+    CHECK_CASE(test_many_inputs);
     return check_finish();
 }

@@ -542,18 +542,19 @@ static void test_viewpoint_round_trip_and_bounds(void)
     CHECK(memcmp(&v, &w, sizeof v) == 0, "array -> viewpoint changed the order");
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_basic_rotations();
-    test_axis_angle_and_quaternion();
-    test_angle_and_orthonormalize();
-    test_mat4();
-    test_camera_axes();
-    test_similarity();
-    test_umeyama();
-    test_viewpoint_hand_worked();
-    test_viewpoint_phi();
-    test_viewpoint_properties();
-    test_viewpoint_round_trip_and_bounds();
+    check_args(argc, argv);
+    CHECK_CASE(test_basic_rotations);
+    CHECK_CASE(test_axis_angle_and_quaternion);
+    CHECK_CASE(test_angle_and_orthonormalize);
+    CHECK_CASE(test_mat4);
+    CHECK_CASE(test_camera_axes);
+    CHECK_CASE(test_similarity);
+    CHECK_CASE(test_umeyama);
+    CHECK_CASE(test_viewpoint_hand_worked);
+    CHECK_CASE(test_viewpoint_phi);
+    CHECK_CASE(test_viewpoint_properties);
+    CHECK_CASE(test_viewpoint_round_trip_and_bounds);
     return check_finish();
 }

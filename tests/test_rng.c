@@ -81,10 +81,11 @@ static void test_normal(void)
     CHECK_NEAR((double)tail / n, 0.05, 0.003);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_reproducible();
-    test_uniform();
-    test_normal();
+    check_args(argc, argv);
+    CHECK_CASE(test_reproducible);
+    CHECK_CASE(test_uniform);
+    CHECK_CASE(test_normal);
     return check_finish();
 }

@@ -145,8 +145,9 @@ static void test_undistort(void)
     vf_image_free(&out);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    check_args(argc, argv);
     static const float white[3] = {1, 1, 1};
     char src[VF_PATH_MAX], dst[VF_PATH_MAX], src2[VF_PATH_MAX], dst2[VF_PATH_MAX];
     vf_path_join(src, sizeof src, vf_test_tmpdir(), "one");
@@ -157,8 +158,8 @@ int main(void)
     vf_mkdirs(src2);
     test_one_size(src, dst);
     test_mixed(src2, dst2);
-    test_key_white();
-    test_undistort();
+    CHECK_CASE(test_key_white);
+    CHECK_CASE(test_undistort);
 
     vf_sfm_images set;
     CHECK(vf_sfm_images_prepare(dst2 /* only subfolders */, dst, white, &set) == VF_EINPUT,

@@ -169,13 +169,14 @@ static void test_attack_file(void)
           "a short v_star is refused: %s", vf_error_message());
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_wilson();
-    test_describe();
-    test_advice();
-    test_spread();
-    test_smoother();
-    test_attack_file();
+    check_args(argc, argv);
+    CHECK_CASE(test_wilson);
+    CHECK_CASE(test_describe);
+    CHECK_CASE(test_advice);
+    CHECK_CASE(test_spread);
+    CHECK_CASE(test_smoother);
+    CHECK_CASE(test_attack_file);
     return check_finish();
 }

@@ -282,19 +282,20 @@ static void test_camera_ingest(void)
     }
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    check_args(argc, argv);
     vf_log_set_quiet(1);
     if (load_recording() != 0) {
         fprintf(stderr, "cannot load the recording: %s\n", vf_error_message());
         return 1;
     }
-    test_negotiation();
+    CHECK_CASE(test_negotiation);
     stream_and_check(V4L2_PIX_FMT_YUYV, 2, 12, 2.0);
     stream_and_check(V4L2_PIX_FMT_MJPEG, 3, 12, 3.0);
-    test_yuyv_colours();
-    test_errors();
-    test_camera_ingest();
+    CHECK_CASE(test_yuyv_colours);
+    CHECK_CASE(test_errors);
+    CHECK_CASE(test_camera_ingest);
     for (int i = 0; i < FRAMES; i++) {
         vf_rgb8_free(&sources[i]);
         free(yuyv[i]);

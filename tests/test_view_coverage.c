@@ -64,11 +64,12 @@ static void test_too_few(void)
     CHECK(vf_view_coverage(c2w, 1, &b) == VF_EINPUT, "one camera covers no range");
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_frontal_arc();
-    test_arc_across_180();
-    test_full_circle();
-    test_too_few();
+    check_args(argc, argv);
+    CHECK_CASE(test_frontal_arc);
+    CHECK_CASE(test_arc_across_180);
+    CHECK_CASE(test_full_circle);
+    CHECK_CASE(test_too_few);
     return check_finish();
 }

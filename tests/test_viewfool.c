@@ -770,21 +770,22 @@ static void test_reports(void)
     CHECK(memcmp(&res, &again, sizeof res) == 0, "random search is reproducible");
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_log_jacobian();
-    test_entropy();
-    test_gradient_single();
-    test_gradient_mixture();
-    test_nes_converges();
-    test_pepg_converges();
-    test_entropy_widens();
-    test_entropy_balance();
-    test_mixture_two_modes();
-    test_seeds();
-    test_resume();
-    test_config();
-    test_callback_errors();
-    test_reports();
+    check_args(argc, argv);
+    CHECK_CASE(test_log_jacobian);
+    CHECK_CASE(test_entropy);
+    CHECK_CASE(test_gradient_single);
+    CHECK_CASE(test_gradient_mixture);
+    CHECK_CASE(test_nes_converges);
+    CHECK_CASE(test_pepg_converges);
+    CHECK_CASE(test_entropy_widens);
+    CHECK_CASE(test_entropy_balance);
+    CHECK_CASE(test_mixture_two_modes);
+    CHECK_CASE(test_seeds);
+    CHECK_CASE(test_resume);
+    CHECK_CASE(test_config);
+    CHECK_CASE(test_callback_errors);
+    CHECK_CASE(test_reports);
     return check_finish();
 }

@@ -49,10 +49,11 @@ static void test_error_chaining(void)
           "chained message: %s", vf_error_message());
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    test_json_round_trip();
-    test_error_chaining();
+    check_args(argc, argv);
+    CHECK_CASE(test_json_round_trip);
+    CHECK_CASE(test_error_chaining);
     char root[VF_PATH_MAX], path[VF_PATH_MAX];
     vf_path_join(root, sizeof root, vf_test_tmpdir(), "ws");
     vf_workspace ws;
