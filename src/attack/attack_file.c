@@ -363,7 +363,7 @@ vf_status vf_attack_file_sample(const vf_attack_file *a, vf_rng *rng, int n, dou
         return vf_fail(VF_EINPUT, "the attack has no distribution to sample (random search "
                                   "keeps none): run it with --method nes or pepg");
     vf_attack_state st = {.components = a->components};
-    vf_attack_config cfg;
+    vf_attack_config cfg = {0}; /* the sampler reads only the bounds */
     memcpy(cfg.bounds.lo, a->lo, sizeof a->lo);
     memcpy(cfg.bounds.hi, a->hi, sizeof a->hi);
     double total = 0;
