@@ -17,11 +17,11 @@
  * folding_chair, reflex_camera, ...). */
 #include <jansson.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bench_shell.h"
 #include "vf/fsutil.h"
 #include "vf/log.h"
 #include "vf/resources.h"
@@ -65,24 +65,6 @@ typedef struct row {
     int ok;
 } row;
 
-static const char *tool(void)
-{
-    const char *t = getenv("VF_TOOL");
-    return t && *t ? t : "vfcapture";
-}
-
-static int run(const char *fmt, ...)
-{
-    char cmd[8192];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "$ %s\n", cmd);
-    int rc = system(cmd);
-    return rc == 0 ? 0 : -1;
-}
-
 static json_t *load(const char *ws, const char *file)
 {
     char path[VF_PATH_MAX * 2];
@@ -123,10 +105,10 @@ static void method_row(const options *o, const object_spec *obj, const char *ws,
     char saved[VF_PATH_MAX * 2];
     snprintf(saved, sizeof saved, "%s/table1_%s.json", ws, methods[m].name);
     if (!vf_is_file(saved)) {
-        if (run("'%s' attack '%s' --label %s --space both %s --steps %d --quiet", tool(), ws,
-                obj->labels, methods[m].args, o->steps) ||
-            run("'%s' real '%s' --fluctuation-samples %d --natural-views %d --quiet", tool(), ws,
-                o->fluct, o->natural))
+        if (bench_run("'%s' attack '%s' --label %s --space both %s --steps %d --quiet",
+                      bench_tool(), ws, obj->labels, methods[m].args, o->steps) ||
+            bench_run("'%s' real '%s' --fluctuation-samples %d --natural-views %d --quiet",
+                      bench_tool(), ws, o->fluct, o->natural))
             return;
         json_t *real = load(ws, "real/real.json");
         json_object_set_new(real, "attack_seconds", json_real(stage_seconds(ws, "attack")));
@@ -211,10 +193,11 @@ int main(int argc, char **argv)
         if (vf_shared_path(rel, model, sizeof model) != VF_OK)
             continue;
         if (isnan(stage_seconds(ws, "ingest")) &&
-            run("'%s' ingest '%s' -o '%s' --views %d --quiet", tool(), model, ws, o.views))
+            bench_run("'%s' ingest '%s' -o '%s' --views %d --quiet", bench_tool(), model, ws,
+                      o.views))
             continue;
         if (isnan(stage_seconds(ws, "train")) &&
-            run("'%s' train '%s' --minutes %g --quiet", tool(), ws, o.train_minutes))
+            bench_run("'%s' train '%s' --minutes %g --quiet", bench_tool(), ws, o.train_minutes))
             continue;
         ingest_s[k] = stage_seconds(ws, "ingest");
         train_s[k] = stage_seconds(ws, "train");

@@ -49,7 +49,9 @@ static const char usage[] =
     "                         NeRF-synthetic)\n"
     "      --samples N        model: Cycles samples a pixel (default 32)\n"
     "      --seed S           model: where on the hemisphere the views are (default 0)\n"
-    CLI_COMMON_HELP;
+    "      --scene S          model: studio (white, transparent background; the paper's) or\n"
+    "                         room (on a textured floor inside a textured wall, as a photo in\n"
+    "                         a room; default studio)\n" CLI_COMMON_HELP;
 
 typedef struct ingest_options {
     const char *source;     /* video file, photo folder or 3D model */
@@ -73,6 +75,7 @@ enum {
     OPT_RENDER_SIZE,
     OPT_SAMPLES,
     OPT_SEED,
+    OPT_SCENE,
 };
 
 /* Parse "WxH". */
@@ -170,6 +173,11 @@ static vf_status apply_option(int c, const char *arg, ingest_options *opt)
     case OPT_RENDER_SIZE:
     case OPT_SAMPLES:
     case OPT_SEED: return apply_model_option(c, arg, &opt->req.model);
+    case OPT_SCENE:
+        if (strcmp(arg, "studio") && strcmp(arg, "room"))
+            return vf_fail(VF_EINPUT, "--scene: use studio or room, not '%s'", arg);
+        opt->req.model.scene = arg;
+        return VF_OK;
     case OPT_PIXEL_FORMAT:
         if (!strcasecmp(arg, "mjpeg") || !strcasecmp(arg, "mjpg"))
             cap->pixel_format = V4L2_PIX_FMT_MJPEG;
@@ -202,6 +210,7 @@ static int parse_options(int argc, char **argv, ingest_options *opt)
         {"render-size", required_argument, NULL, OPT_RENDER_SIZE},
         {"samples", required_argument, NULL, OPT_SAMPLES},
         {"seed", required_argument, NULL, OPT_SEED},
+        {"scene", required_argument, NULL, OPT_SCENE},
         {0, 0, 0, 0},
     };
     vf_ingest_request_defaults(&opt->req);

@@ -23,6 +23,13 @@ static const char usage[] =
     "                        order (file names say nothing), so all pairs up to 150 photos, and\n"
     "                        beyond that the most similar images by a vocabulary tree built from\n"
     "                        the capture's own features (retrieval)\n"
+    "      --no-check        keep a sequential or retrieval model unchecked. By default 16 of\n"
+    "                        its frames are matched all pairs and registered on their own, and\n"
+    "                        must agree with it (medians under 2 deg and 2% of the cameras'\n"
+    "                        spread, at most a fifth over 5 deg off): a wrong model that\n"
+    "                        registers every frame looks fine by every count. When they\n"
+    "                        disagree, or too few frames register, auto matches all pairs\n"
+    "                        instead; a chosen matcher is an error\n"
     "      --overlap N       sequential: match each frame with its next N (default 10, plus\n"
     "                        frames 2^k ahead)\n"
     "      --vocab-tree FILE a COLMAP vocabulary tree: sequential matching then also detects\n"
@@ -35,8 +42,7 @@ static const char usage[] =
     "                        k1, k2, p1, p2 (a calibration result; not refined)\n"
     "      --max-features N  SIFT features per frame (default 2048)\n"
     "      --min-registered F  share of frames that must register (default 0.5)\n"
-    "      --no-undistort    skip the undistorted images\n" CLI_COMMON_HELP
-    "\n"
+    "      --no-undistort    skip the undistorted images\n" CLI_COMMON_HELP "\n"
     "COLMAP is `colmap` on PATH, or $VF_COLMAP.\n";
 
 enum {
@@ -49,6 +55,7 @@ enum {
     OPT_MAX_FEATURES,
     OPT_MIN_REGISTERED,
     OPT_NO_UNDISTORT,
+    OPT_NO_CHECK,
 };
 
 static vf_status parse_option(int c, const char *arg, vf_poses_options *opt)
@@ -89,6 +96,7 @@ static vf_status parse_option(int c, const char *arg, vf_poses_options *opt)
     case OPT_NO_UNDISTORT:
         opt->undistort = 0;
         return VF_OK;
+    case OPT_NO_CHECK: opt->check = 0; return VF_OK;
     }
     return vf_fail(VF_EINPUT, "unknown option");
 }
@@ -107,6 +115,7 @@ static vf_status parse_options(int argc, char **argv, const char **workspace,
         {"max-features", required_argument, NULL, OPT_MAX_FEATURES},
         {"min-registered", required_argument, NULL, OPT_MIN_REGISTERED},
         {"no-undistort", no_argument, NULL, OPT_NO_UNDISTORT},
+        {"no-check", no_argument, NULL, OPT_NO_CHECK},
         {0, 0, 0, 0},
     };
     vf_poses_defaults(opt);

@@ -4,7 +4,8 @@
 # not left behind: a file that is not a glTF, a compressed glTF (EXT_meshopt_compression, which
 # Debian's Blender importer lacks), a model whose only material is fully transparent (it
 # renders empty), a model whose vertices are all at one point, a missing Blender, and `real` on
-# a workspace that was not made from a model or has no attack yet.
+# a workspace that was not made from a model or has no attack yet; and that `--scene room` renders
+# opaque RGB views and records its scene.
 source "$(dirname "$0")/shell_checks.sh"
 
 models="$shared/data/models_3d"
@@ -22,6 +23,19 @@ t = json.load(open('$ws/ingest/transforms.json'))
 ok = o['model'].endswith('bell_pepper__yellow_bell_pepper.glb') and abs(o['radius'] - 1) < 1e-3 \
      and o['transform']['scale'] > 0 and len(t['frames']) == 3
 sys.exit(0 if ok else 1)" && ok || bad "object.json records the model, its unit-sphere transform, 3 views"
+# the room: the object on a textured floor inside a wall, opaque RGB renders
+expect 0 "a small capture in the room" -- \
+  "$tool" ingest "$models/bell_pepper__yellow_bell_pepper.glb" -o "$tmp/room" "${tiny[@]}" --scene room
+python3 -c "
+import json, struct, sys
+o = json.load(open('$tmp/room/ingest/object.json'))
+png = open('$tmp/room/ingest/images/r_000.png', 'rb').read(26)
+colour_type = png[25]  # IHDR: 2 is RGB, 6 is RGBA
+sys.exit(0 if o['render']['scene'] == 'room' and o['mean_coverage'] is None and colour_type == 2 else 1)" \
+  && ok || bad "a room capture records its scene and renders opaque RGB"
+expect 1 "bad scene" -- "$tool" ingest "$models/bell_pepper__yellow_bell_pepper.glb" -o "$tmp/room2" \
+  "${tiny[@]}" --scene beach
+one_line_naming "bad scene" "--scene"
 snapshot() { (cd "$ws" && find . -type f -exec md5sum {} + | sort); }
 snapshot >"$tmp/before"
 

@@ -83,44 +83,13 @@ static inline double quantile(double *v, int n, double q)
     return v[i];
 }
 
-typedef struct pose_errors {
-    double rot_median, rot_p90; /* degrees */
-    double pos_median, pos_p90; /* share of the mean camera distance (4 in the object frame) */
-} pose_errors;
-
-/* Align the reference c2w matrices (OpenGL axes) onto ours (Umeyama on the camera centres)
- * and measure per camera the rotation error (degrees) and the position error (share of
- * `distance`, our mean camera distance). ours[i] and ref[i] are the same photo. */
-static inline pose_errors compare_poses(const double *const *ours, const double *const *ref,
-                                        int n, double distance)
+/* vf_pose_compare against the object frame's camera distance (NaNs when it cannot align). */
+static inline vf_pose_agreement compare_poses(const double *const *ours, const double *const *ref,
+                                              int n)
 {
-    pose_errors e = {NAN, NAN, NAN, NAN};
-    double *src = malloc(sizeof(double) * 3 * n), *dst = malloc(sizeof(double) * 3 * n);
-    double *rot = malloc(sizeof(double) * n), *pos = malloc(sizeof(double) * n);
-    vf_similarity align;
-    for (int i = 0; i < n; i++) {
-        vf_mat4_translation(ref[i], src + 3 * i);
-        vf_mat4_translation(ours[i], dst + 3 * i);
-    }
-    if (vf_similarity_umeyama(src, dst, n, &align) == VF_OK) {
-        for (int i = 0; i < n; i++) {
-            double moved[16], r_ours[9], r_ref[9], p[3], d2 = 0;
-            vf_similarity_apply_c2w(&align, ref[i], moved);
-            vf_mat4_rotation(moved, r_ref);
-            vf_mat4_rotation(ours[i], r_ours);
-            rot[i] = vf_rot_angle_deg(r_ours, r_ref);
-            vf_mat4_translation(moved, p);
-            for (int k = 0; k < 3; k++)
-                d2 += (p[k] - dst[3 * i + k]) * (p[k] - dst[3 * i + k]);
-            pos[i] = sqrt(d2) / distance;
-        }
-        e = (pose_errors){quantile(rot, n, 0.5), quantile(rot, n, 0.9), quantile(pos, n, 0.5),
-                          quantile(pos, n, 0.9)};
-    }
-    free(src);
-    free(dst);
-    free(rot);
-    free(pos);
+    vf_pose_agreement e;
+    if (vf_pose_compare(ours, ref, n, VF_CAMERA_DISTANCE, &e) != VF_OK)
+        e.rot_median = e.rot_p90 = e.pos_median = e.pos_p90 = NAN;
     return e;
 }
 
@@ -129,10 +98,10 @@ typedef struct pose_limits {
     double rot_median, rot_p90, pos_median, pos_p90;
 } pose_limits;
 
-static inline pose_errors check_poses(const double *const *ours, const double *const *ref, int n,
-                                      pose_limits limit)
+static inline vf_pose_agreement check_poses(const double *const *ours, const double *const *ref,
+                                            int n, pose_limits limit)
 {
-    pose_errors e = compare_poses(ours, ref, n, VF_CAMERA_DISTANCE);
+    vf_pose_agreement e = compare_poses(ours, ref, n);
     printf("rotation error: median %.3f deg, p90 %.3f deg; position error: median %.3f%%, "
            "p90 %.3f%% of the camera distance\n",
            e.rot_median, e.rot_p90, 100 * e.pos_median, 100 * e.pos_p90);

@@ -129,7 +129,7 @@ static void poses_of_video(const json_t *report)
         }
     CHECK(matched == KEEP, "every frame matched to its photo (%d)", matched);
     if (matched == KEEP) {
-        pose_errors e = compare_poses(mine, theirs, matched, VF_CAMERA_DISTANCE);
+        vf_pose_agreement e = compare_poses(mine, theirs, matched);
         printf("against the reference: rotation median %.3f deg, p90 %.3f deg; position median "
                "%.3f%%, p90 %.3f%%\n",
                e.rot_median, e.rot_p90, 100 * e.pos_median, 100 * e.pos_p90);

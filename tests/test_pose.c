@@ -368,6 +368,40 @@ static void test_umeyama(void)
     CHECK(vf_similarity_umeyama(src, dst, 2, &fit) == VF_EINPUT, "2 points accepted");
 }
 
+/* Twenty cameras seen in another frame (a similarity away) agree exactly; turning two of them
+ * by 10 degrees shows as a max of 10, two over 5 degrees and an unchanged median. */
+static void test_pose_compare(void)
+{
+    enum { N = 20 };
+    double ours[N][16], ref[N][16];
+    const double *a[N], *b[N];
+    vf_similarity frame = random_similarity();
+    for (int i = 0; i < N; i++) {
+        vf_viewpoint v = {.psi = 18.0 * i, .theta = uniform(10, 60), .phi = uniform(-5, 5)};
+        vf_viewpoint_to_c2w(&v, ref[i]);
+        vf_similarity_apply_c2w(&frame, ref[i], ours[i]);
+        a[i] = ours[i];
+        b[i] = ref[i];
+    }
+    vf_pose_agreement g;
+    CHECK(vf_pose_compare(a, b, N, 0, &g) == VF_OK, "%s", vf_error_message());
+    CHECK(g.count == N && g.rot_max < 1e-6 && g.pos_p90 < 1e-9 && g.rot_over_5deg == 0,
+          "exact: max %g deg, position p90 %g", g.rot_max, g.pos_p90);
+    for (int i = 3; i < N; i += 10) { /* turn cameras 3 and 13 by 10 degrees about their x */
+        double turn[9], rot[9], pos[3], turned[9];
+        vf_rot_x(rad(10), turn);
+        vf_mat4_rotation(ours[i], rot);
+        vf_mat4_translation(ours[i], pos);
+        vf_mat3_mul(rot, turn, turned);
+        vf_mat4_from_rt(turned, pos, ours[i]);
+    }
+    CHECK(vf_pose_compare(a, b, N, 0, &g) == VF_OK, "%s", vf_error_message());
+    CHECK(fabs(g.rot_max - 10) < 1e-6 && g.rot_over_5deg == 2 && g.rot_median < 1e-6,
+          "two turned: max %g deg, %d over 5, median %g", g.rot_max, g.rot_over_5deg,
+          g.rot_median);
+    CHECK(vf_pose_compare(a, b, 2, 0, &g) == VF_EINPUT, "2 cameras accepted");
+}
+
 /* ---- viewpoint ---- */
 
 static void c2w_parts(const vf_viewpoint *v, double pos[3], double view[3], double up[3])
@@ -552,6 +586,7 @@ int main(int argc, char **argv)
     CHECK_CASE(test_camera_axes);
     CHECK_CASE(test_similarity);
     CHECK_CASE(test_umeyama);
+    CHECK_CASE(test_pose_compare);
     CHECK_CASE(test_viewpoint_hand_worked);
     CHECK_CASE(test_viewpoint_phi);
     CHECK_CASE(test_viewpoint_properties);

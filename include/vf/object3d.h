@@ -49,6 +49,7 @@ typedef struct vf_object3d {
     char model[VF_PATH_MAX];        /* absolute path of the model file */
     vf_object3d_transform transform;
     int samples;                    /* Cycles samples the training views were rendered with */
+    char scene[16];                 /* "studio" or "room", as the training views */
 } vf_object3d;
 
 /* Whether path names a file Blender imports here (.glb, .gltf, .obj, .blend), by its extension. */
@@ -63,6 +64,10 @@ typedef struct vf_object3d_capture {
     double camera_angle_x;  /* horizontal field of view, radians (default the NeRF camera) */
     double min_elevation;   /* degrees above the horizon (default 5) */
     uint64_t seed;          /* where on the hemisphere the views are (default 0) */
+    const char *scene;      /* "studio": white light from everywhere, transparent background
+                             * (default, the paper's); "room": the object on a textured floor
+                             * inside a textured wall, opaque (features for structure from
+                             * motion, as around a real object) */
 } vf_object3d_capture;
 
 void vf_object3d_capture_defaults(vf_object3d_capture *c);
@@ -73,11 +78,13 @@ void vf_object3d_capture_defaults(vf_object3d_capture *c);
 void vf_object3d_capture_poses(const vf_object3d_capture *c, double *c2w);
 
 /* Render the capture of the model into out_dir (a staging folder): images/r_NNN.png and
- * test/r_NNN.png (RGBA, transparent background), transforms.json, transforms_test.json,
+ * test/r_NNN.png (RGBA with a transparent background in the studio, RGB in the room),
+ * transforms.json, transforms_test.json,
  * object.json and blender.log. Views already rendered there are kept (an interrupted ingest
  * resumes). Errors, one line each: Blender missing (VF_EINTERNAL, with the install line), a
  * file it cannot import (VF_EINPUT, naming a missing glTF extension and how to convert),
- * a model without geometry or whose views are all empty (VF_EINPUT). *report (may be NULL)
+ * a model without geometry or whose studio views are all empty (VF_EINPUT; in the room the
+ * background hides how much the object covers, and mean_coverage is null). *report (may be NULL)
  * gets the manifest summary: frames, test_frames, width, height, seconds, the transform. */
 vf_status vf_object3d_ingest(const char *model_path, const vf_object3d_capture *c,
                              const char *out_dir, json_t **report);

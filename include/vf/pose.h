@@ -125,6 +125,21 @@ void vf_similarity_to_mat4(const vf_similarity *s, double out[16]);
  * (nearly) collinear, so the rotation is not determined. */
 vf_status vf_similarity_umeyama(const double *src, const double *dst, int n, vf_similarity *out);
 
+/* How far two sets of poses of the same n cameras disagree (ours[i] and ref[i] are the same
+ * camera; c2w matrices, either axis convention as long as both use it): ref is aligned onto
+ * ours by a similarity of the camera centres, then per camera the rotation error (degrees)
+ * and the position error as a share of `distance` (<= 0: the mean distance of our cameras
+ * from their centroid). VF_EINPUT as vf_similarity_umeyama; out of memory VF_EINTERNAL. */
+typedef struct vf_pose_agreement {
+    int count;
+    double rot_median, rot_p90, rot_max; /* degrees */
+    double pos_median, pos_p90;          /* shares of the distance */
+    int rot_over_5deg;                   /* cameras more than 5 degrees off */
+} vf_pose_agreement;
+
+vf_status vf_pose_compare(const double *const *ours, const double *const *ref, int n,
+                          double distance, vf_pose_agreement *out);
+
 /* ---- the ViewFool viewpoint ---- */
 
 #define VF_CAMERA_DISTANCE 4.0 /* nominal camera distance to the object, scene units */

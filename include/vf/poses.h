@@ -13,7 +13,13 @@
  * frames, all pairs; frames of a video or webcam, in capture order, sequential; a photo
  * folder, whose file names say nothing about where the photos were taken, all pairs up to 150
  * photos and beyond that retrieval (each photo with its 40 most similar by a vocabulary tree
- * built from the capture's own features). The "auto" camera model is OPENCV, or SIMPLE_RADIAL
+ * built from the capture's own features). A model from sequential or retrieval matching is
+ * then checked: 16 of its frames, matched all pairs with each other and registered on their
+ * own, must agree with it (medians under 2 deg and 2% of the cameras' spread, no more than a
+ * fifth over 5 deg).
+ * When they disagree, or too few frames register, "auto" falls back to all pairs; with a
+ * matcher the user chose either is VF_EINPUT. The
+ * "auto" camera model is OPENCV, or SIMPLE_RADIAL
  * when more than 40% of the frames' pixels are removed background (few features). */
 #ifndef VF_POSES_H
 #define VF_POSES_H
@@ -36,6 +42,8 @@ typedef struct vf_poses_options {
     int max_features;         /* SIFT features per frame (2048) */
     double min_registered;    /* share of frames that must register (0.5) */
     int undistort;            /* write the undistorted images (1) */
+    int check;                /* check a sequential or retrieval model against all-pairs
+                               * matching of a sample of its frames (1) */
     int has_intrinsics;       /* known camera, not refined: `known` holds it; width 0 means
                                * "stated for the frames as they are", else it is scaled */
     vf_camera known;
@@ -44,12 +52,18 @@ typedef struct vf_poses_options {
 
 void vf_poses_defaults(vf_poses_options *o);
 
+/* The matcher "auto" chooses for `frames` frames, in capture order (a video, a webcam) or not
+ * (photos): "exhaustive", "sequential" or "retrieval". */
+const char *vf_poses_auto_matcher(int frames, int ordered);
+
 /* VF_EINPUT naming the option that cannot run. */
 vf_status vf_poses_options_check(const vf_poses_options *o);
 
 /* Run the stage on an open workspace with an ingest. *summary gets {"registered", "total",
  * "models", "unregistered", "reprojection_error_px", "points", "matcher", "camera_model",
- * "cameras", "up_method", "center_method", "scale_to_object", "seconds" {per COLMAP step}}
+ * "cameras", "up_method", "center_method", "scale_to_object", "seconds" {per COLMAP step},
+ * "check" {"verdict", "sampled", "registered", "rotation_median_deg", ...} or null, and
+ * "fallback_from" (the matcher first chosen) when "auto" fell back to all pairs}
  * (a new reference). */
 vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **summary);
 

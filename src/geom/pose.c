@@ -2,6 +2,7 @@
 #include "vf/pose.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const double PI = 3.14159265358979323846;
@@ -477,6 +478,74 @@ vf_status vf_similarity_umeyama(const double *src, const double *dst, int n, vf_
         s.t[k] = mu_dst[k] - s.scale * r_mu[k];
     *out = s;
     return VF_OK;
+}
+
+static double distance3(const double a[3], const double b[3])
+{
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The q-quantile (nearest rank) of n sorted values. */
+static double sorted_quantile(const double *v, int n, double q)
+{
+    return v[(int)(q * (n - 1) + 0.5)];
+}
+
+vf_status vf_pose_compare(const double *const *ours, const double *const *ref, int n,
+                          double distance, vf_pose_agreement *out)
+{
+    *out = (vf_pose_agreement){.count = n};
+    if (n < 3)
+        return vf_fail(VF_EINPUT, "need at least 3 cameras to compare poses, got %d", n);
+    double *src = malloc(sizeof(double) * 3 * (size_t)n);
+    double *dst = malloc(sizeof(double) * 3 * (size_t)n);
+    double *rot = malloc(sizeof(double) * (size_t)n), *pos = malloc(sizeof(double) * (size_t)n);
+    vf_similarity align;
+    vf_status status = src && dst && rot && pos ? VF_OK : vf_fail(VF_EINTERNAL, "out of memory");
+    for (int i = 0; status == VF_OK && i < n; i++) {
+        vf_mat4_translation(ref[i], src + 3 * i);
+        vf_mat4_translation(ours[i], dst + 3 * i);
+    }
+    if (status == VF_OK)
+        status = vf_similarity_umeyama(src, dst, n, &align);
+    if (status == VF_OK && distance <= 0) {
+        double c[3];
+        centroid(dst, n, c);
+        distance = 0;
+        for (int i = 0; i < n; i++)
+            distance += distance3(dst + 3 * i, c) / n;
+    }
+    for (int i = 0; status == VF_OK && i < n; i++) {
+        double moved[16], r_ours[9], r_ref[9], p[3];
+        vf_similarity_apply_c2w(&align, ref[i], moved);
+        vf_mat4_rotation(moved, r_ref);
+        vf_mat4_rotation(ours[i], r_ours);
+        rot[i] = vf_rot_angle_deg(r_ours, r_ref);
+        out->rot_over_5deg += rot[i] > 5.0;
+        vf_mat4_translation(moved, p);
+        pos[i] = distance > 0 ? distance3(p, dst + 3 * i) / distance : 0;
+    }
+    if (status == VF_OK) {
+        qsort(rot, (size_t)n, sizeof *rot, compare_doubles);
+        qsort(pos, (size_t)n, sizeof *pos, compare_doubles);
+        out->rot_median = sorted_quantile(rot, n, 0.5);
+        out->rot_p90 = sorted_quantile(rot, n, 0.9);
+        out->rot_max = rot[n - 1];
+        out->pos_median = sorted_quantile(pos, n, 0.5);
+        out->pos_p90 = sorted_quantile(pos, n, 0.9);
+    }
+    free(src);
+    free(dst);
+    free(rot);
+    free(pos);
+    return status;
 }
 
 /* ---- viewpoint ---- */

@@ -8,10 +8,14 @@
 #                  centre the model's bounding box at the origin and scale it into the unit sphere
 #     width, height, fx, fy, cx, cy   the pinhole camera (pixels)
 #     samples      Cycles samples a pixel (adaptive sampling; this build has no denoiser)
+#     scene        "studio" (default: white light from everywhere, transparent background) or
+#                  "room" (the object stands on a textured floor inside a textured wall, opaque
+#                  RGB: what a photo of it in a room gives structure from motion to hold on to)
 #     views        [{"file": NAME.png, "c2w": 16 numbers}], camera-to-world, row-major,
 #                  OpenGL axes (x right, y up, looking along -z), in the normalized object frame
 #                  (z up: Blender's own world axes; the glTF importer turns y-up into z-up)
-#     output_dir   where the PNGs go (RGBA, transparent background, 8 bit, sRGB)
+#     output_dir   where the PNGs go (8 bit, sRGB; RGBA with a transparent background in the
+#                  studio)
 #     info         where to write what was measured: the transform, vertex and mesh counts
 # It prints one "vf-view I N FILE" line a finished view and "vf-error: MESSAGE" before a
 # non-zero exit (2: the input is at fault, 4: the installation), so the C side can show
@@ -179,11 +183,64 @@ def setup_scene():
     return scene, camera
 
 
+def textured_material(name, scale, colors):
+    """A procedural material with corners at every scale (bricks over noise): real texture
+    for SIFT, the same from every view."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bsdf = nodes["Principled BSDF"]
+    bsdf.inputs["Roughness"].default_value = 0.8
+    coords = nodes.new("ShaderNodeTexCoord")
+    bricks = nodes.new("ShaderNodeTexBrick")
+    bricks.inputs["Scale"].default_value = scale
+    bricks.inputs["Mortar Size"].default_value = 0.03
+    noise = nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = scale * 4
+    noise.inputs["Detail"].default_value = 6
+    links.new(coords.outputs["Object"], bricks.inputs["Vector"])
+    links.new(coords.outputs["Object"], noise.inputs["Vector"])
+    ramp = nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].color = colors[0]
+    ramp.color_ramp.elements[1].color = colors[1]
+    links.new(noise.outputs["Fac"], ramp.inputs["Fac"])
+    links.new(ramp.outputs["Color"], bricks.inputs["Color1"])
+    bricks.inputs["Color2"].default_value = colors[2]
+    bricks.inputs["Mortar"].default_value = colors[3]
+    links.new(bricks.outputs["Color"], bsdf.inputs["Base Color"])
+    return mat
+
+
+def add_room(scene, floor_z):
+    """A floor under the object (at its lowest point) and an open-topped round wall, far enough
+    that the cameras at distance 4 stay inside; the white sky still lights it from above."""
+    bpy.ops.mesh.primitive_plane_add(size=30.0, location=(0, 0, floor_z))
+    floor = bpy.context.active_object
+    floor.data.materials.append(textured_material(
+        "vf_floor", 6.0, [(0.35, 0.22, 0.12, 1), (0.75, 0.55, 0.35, 1), (0.55, 0.4, 0.3, 1),
+                          (0.1, 0.08, 0.06, 1)]))
+    bpy.ops.mesh.primitive_cylinder_add(vertices=64, radius=12.0, depth=16.0, end_fill_type="NOTHING",
+                                        location=(0, 0, floor_z + 8.0))
+    wall = bpy.context.active_object
+    wall.data.materials.append(textured_material(
+        "vf_wall", 3.0, [(0.5, 0.55, 0.6, 1), (0.85, 0.85, 0.8, 1), (0.3, 0.35, 0.45, 1),
+                         (0.95, 0.95, 0.95, 1)]))
+    scene.render.film_transparent = False
+    scene.render.image_settings.color_mode = "RGB"
+    scene.cycles.max_bounces = 3  # diffuse walls: more bounces cost time, not features
+
+
 import_model(job["model"])
 first_frame()
 meshes = [o for o in bpy.context.scene.objects if o.type == "MESH"]
 info = normalize(meshes, job.get("normalize"))
 scene, camera = setup_scene()
+if job.get("scene", "studio") == "room":
+    # the floor at the object's lowest point: from the fit, or from the vertices when the
+    # transform was given
+    add_room(scene, float(numpy.array(world_vertices(meshes))[:, 2].min()))
+elif job.get("scene", "studio") != "studio":
+    fail("unknown scene %r: use studio or room" % job.get("scene"))
 with open(job["info"] + ".tmp", "w") as f:
     json.dump(info, f, indent=1)
 os.replace(job["info"] + ".tmp", job["info"])

@@ -36,7 +36,8 @@ void vf_object3d_capture_defaults(vf_object3d_capture *c)
                                .distance = VF_CAMERA_DISTANCE,
                                .camera_angle_x = VF_NERF_CAMERA_ANGLE_X,
                                .min_elevation = 5,
-                               .seed = 0};
+                               .seed = 0,
+                               .scene = "studio"};
 }
 
 void vf_object3d_capture_poses(const vf_object3d_capture *c, double *c2w)
@@ -113,12 +114,12 @@ static vf_status prepare_folder(const char *model, const vf_object3d_capture *c,
     struct stat st;
     if (stat(model, &st) != 0)
         return vf_fail(VF_EINPUT, "cannot read %s: no such file", model);
-    json_t *request = json_pack("{s:s, s:I, s:I, s:i, s:i, s:i, s:i, s:f, s:f, s:f, s:I}",
-                                "model", model, "bytes", (json_int_t)st.st_size, "mtime",
-                                (json_int_t)st.st_mtime, "views", c->views, "test_views",
-                                c->test_views, "size", c->size, "samples", c->samples,
-                                "distance", c->distance, "camera_angle_x", c->camera_angle_x,
-                                "min_elevation", c->min_elevation, "seed", (json_int_t)c->seed);
+    json_t *request =
+        json_pack("{s:s, s:I, s:I, s:i, s:i, s:i, s:i, s:f, s:f, s:f, s:I, s:s}", "model", model,
+                  "bytes", (json_int_t)st.st_size, "mtime", (json_int_t)st.st_mtime, "views",
+                  c->views, "test_views", c->test_views, "size", c->size, "samples", c->samples,
+                  "distance", c->distance, "camera_angle_x", c->camera_angle_x, "min_elevation",
+                  c->min_elevation, "seed", (json_int_t)c->seed, "scene", c->scene);
     static const char *const renders[] = {"images", "test", NULL};
     return vf__keep_renders_for(out_dir, request, renders);
 }
@@ -128,16 +129,16 @@ static json_t *object_json(const char *model, const json_t *fit, const vf_object
 {
     struct stat st;
     json_int_t bytes = stat(model, &st) == 0 ? (json_int_t)st.st_size : -1;
-    return json_pack("{s:i, s:s, s:I, s:{s:O, s:O}, s:O, s:O, s:O, s:{s:i, s:i, s:i, s:i, s:f, "
-                     "s:f, s:f}, s:f}",
-                     "format", OBJECT_FORMAT, "model", model, "bytes", bytes, "transform",
-                     "center", json_object_get(fit, "center"), "scale",
-                     json_object_get(fit, "scale"), "vertices", json_object_get(fit, "vertices"),
-                     "meshes", json_object_get(fit, "meshes"), "radius",
-                     json_object_get(fit, "radius"), "render", "views", c->views, "test_views",
-                     c->test_views, "size", c->size, "samples", c->samples, "distance",
-                     c->distance, "camera_angle_x", c->camera_angle_x, "min_elevation",
-                     c->min_elevation, "mean_coverage", coverage);
+    return json_pack(
+        "{s:i, s:s, s:I, s:{s:O, s:O}, s:O, s:O, s:O, s:{s:i, s:i, s:i, s:i, s:f, "
+        "s:f, s:f, s:s}, s:o}",
+        "format", OBJECT_FORMAT, "model", model, "bytes", bytes, "transform", "center",
+        json_object_get(fit, "center"), "scale", json_object_get(fit, "scale"), "vertices",
+        json_object_get(fit, "vertices"), "meshes", json_object_get(fit, "meshes"), "radius",
+        json_object_get(fit, "radius"), "render", "views", c->views, "test_views", c->test_views,
+        "size", c->size, "samples", c->samples, "distance", c->distance, "camera_angle_x",
+        c->camera_angle_x, "min_elevation", c->min_elevation, "scene", c->scene, "mean_coverage",
+        coverage >= 0 ? json_real(coverage) : json_null());
 }
 
 static vf_status transform_from_json(const json_t *doc, const char *path,
@@ -175,20 +176,37 @@ vf_status vf_object3d_ingest(const char *model_path, const vf_object3d_capture *
         status = vf_path_join(images, sizeof images, out_dir, "images");
     if (status == VF_OK)
         status = vf_path_join(test, sizeof test, out_dir, "test");
-    vf__blender_job job = {.model = model, .camera = cam, .samples = c->samples, .c2w = c2w,
-                           .count = c->views, .out_dir = images, .prefix = "r_",
-                           .work_dir = out_dir, .label = "rendering training views"};
+    vf__blender_job job = {.model = model,
+                           .camera = cam,
+                           .samples = c->samples,
+                           .scene = c->scene,
+                           .c2w = c2w,
+                           .count = c->views,
+                           .out_dir = images,
+                           .prefix = "r_",
+                           .work_dir = out_dir,
+                           .label = "rendering training views"};
     if (status == VF_OK)
         status = vf__blender_render(&job, &fit);
     if (status == VF_OK)
         status = transform_from_json(fit, model, &transform);
-    if (status == VF_OK)
+    int studio = !strcmp(c->scene, "studio");
+    if (status == VF_OK && studio)
         status = check_coverage(model, images, c->views, &coverage);
+    if (!studio)
+        coverage = -1; /* the room hides it */
     if (status == VF_OK && c->test_views > 0) {
-        job = (vf__blender_job){.model = model, .transform = &transform, .camera = cam,
-                                .samples = c->samples, .c2w = c2w + 16 * c->views,
-                                .count = c->test_views, .out_dir = test, .prefix = "r_",
-                                .work_dir = out_dir, .label = "rendering test views"};
+        job = (vf__blender_job){.model = model,
+                                .transform = &transform,
+                                .camera = cam,
+                                .samples = c->samples,
+                                .scene = c->scene,
+                                .c2w = c2w + 16 * c->views,
+                                .count = c->test_views,
+                                .out_dir = test,
+                                .prefix = "r_",
+                                .work_dir = out_dir,
+                                .label = "rendering test views"};
         status = vf__blender_render(&job, NULL);
     }
     if (status == VF_OK && (status = vf_path_join(path, sizeof path, out_dir, "transforms.json")) ==
@@ -204,12 +222,13 @@ vf_status vf_object3d_ingest(const char *model_path, const vf_object3d_capture *
     if (status == VF_OK)
         status = vf_json_save(path, object);
     if (status == VF_OK && report)
-        *report = json_pack("{s:s, s:s, s:i, s:i, s:i, s:i, s:s, s:f, s:f, s:O, s:f}", "source",
-                            "model", "input", model, "frames", c->views, "test_frames",
-                            c->test_views, "width", c->size, "height", c->size, "background",
-                            "transparent", "mean_camera_distance", c->distance, "seconds",
-                            vf_now() - start, "transform", json_object_get(object, "transform"),
-                            "mean_coverage", coverage);
+        *report = json_pack("{s:s, s:s, s:i, s:i, s:i, s:i, s:s, s:s, s:f, s:f, s:O, s:O}",
+                            "source", "model", "input", model, "frames", c->views, "test_frames",
+                            c->test_views, "width", c->size, "height", c->size, "scene", c->scene,
+                            "background", studio ? "transparent" : "room", "mean_camera_distance",
+                            c->distance, "seconds", vf_now() - start, "transform",
+                            json_object_get(object, "transform"), "mean_coverage",
+                            json_object_get(object, "mean_coverage"));
     json_decref(object);
     json_decref(fit);
     free(c2w);
@@ -240,6 +259,10 @@ vf_status vf_object3d_load(const vf_workspace *ws, vf_object3d *out)
     long long samples = json_integer_value(json_object_get(json_object_get(doc, "render"),
                                                            "samples"));
     out->samples = samples >= 1 && samples <= 65536 ? (int)samples : 64;
+    const char *scene =
+        json_string_value(json_object_get(json_object_get(doc, "render"), "scene"));
+    snprintf(out->scene, sizeof out->scene, "%s",
+             scene && !strcmp(scene, "room") ? "room" : "studio");
     if (status == VF_OK && !vf_is_file(out->model))
         status = vf_fail(VF_EINPUT, "the model %s this workspace was made from is gone; "
                                     "put it back to check viewpoints against it",
@@ -254,9 +277,17 @@ vf_status vf_object3d_render_images(const vf_object3d *obj, const vf_camera *cam
                                     vf_image *images)
 {
     static const float white[3] = {1, 1, 1};
-    vf__blender_job job = {.model = obj->model, .transform = &obj->transform, .camera = *cam,
-                           .samples = obj->samples, .c2w = c2w, .count = n, .out_dir = dir,
-                           .prefix = prefix, .work_dir = dir, .label = progress_label};
+    vf__blender_job job = {.model = obj->model,
+                           .transform = &obj->transform,
+                           .camera = *cam,
+                           .samples = obj->samples,
+                           .scene = obj->scene,
+                           .c2w = c2w,
+                           .count = n,
+                           .out_dir = dir,
+                           .prefix = prefix,
+                           .work_dir = dir,
+                           .label = progress_label};
     vf_status status = vf__blender_render(&job, NULL);
     int loaded = 0;
     for (int i = 0; status == VF_OK && i < n; i++) {

@@ -16,6 +16,7 @@ typedef struct vf__blender_job {
     const vf_object3d_transform *transform; /* NULL: fit the model into the unit sphere */
     vf_camera camera;
     int samples;
+    const char *scene;     /* "studio" or "room" (blender_render.py) */
     const double *c2w;     /* count x 16, object frame, OpenGL axes */
     int count;
     const char *out_dir;   /* the PNGs */

@@ -34,7 +34,8 @@ void vf_poses_defaults(vf_poses_options *o)
                             .overlap = 10,
                             .max_features = 2048,
                             .min_registered = 0.5,
-                            .undistort = 1};
+                            .undistort = 1,
+                            .check = 1};
 }
 
 vf_status vf_poses_options_check(const vf_poses_options *o)
@@ -57,6 +58,14 @@ vf_status vf_poses_options_check(const vf_poses_options *o)
         return vf_fail(VF_EINPUT, "poses: overlap >= 1, max_features >= 100 and min_registered "
                                   "in (0, 1] are needed");
     return VF_OK;
+}
+
+const char *vf_poses_auto_matcher(int frames, int ordered)
+{
+    return frames <= EXHAUSTIVE_MAX_FRAMES   ? "exhaustive"
+           : ordered                         ? "sequential"
+           : frames <= EXHAUSTIVE_MAX_PHOTOS ? "exhaustive"
+                                             : "retrieval";
 }
 
 /* Fit the known intrinsics to the frames' size (a calibration at another resolution of the
@@ -93,12 +102,7 @@ static void choose_methods(poses_run *run, const char *source)
     const vf_poses_options *opt = run->opt;
     int n = run->frames.count;
     int ordered = !strcmp(source, "video") || !strcmp(source, "camera");
-    run->matcher = opt->matcher;
-    if (!strcmp(run->matcher, "auto"))
-        run->matcher = n <= EXHAUSTIVE_MAX_FRAMES   ? "exhaustive"
-                       : ordered                    ? "sequential"
-                       : n <= EXHAUSTIVE_MAX_PHOTOS ? "exhaustive"
-                                                    : "retrieval";
+    run->matcher = strcmp(opt->matcher, "auto") ? opt->matcher : vf_poses_auto_matcher(n, ordered);
     const char *why = strcmp(opt->matcher, "auto") ? ""
                       : n <= EXHAUSTIVE_MAX_FRAMES ? " (few frames)"
                       : ordered                    ? " (frames of a video, in capture order)"
@@ -161,6 +165,83 @@ static vf_status check_registration(const poses_run *run)
                    "between frames: try sharper frames taken closer together, --matcher "
                    "exhaustive, --camera-model SIMPLE_RADIAL or more --max-features",
                    registered, total, split);
+}
+
+static json_t *check_json(const poses_check *c)
+{
+    const vf_pose_agreement *g = &c->agreement;
+    json_t *j = json_pack("{s:s, s:i, s:i, s:f}", "verdict", c->verdict, "sampled", c->sampled,
+                          "registered", c->registered, "seconds", c->seconds);
+    if (c->registered >= 3)
+        json_object_update_new(j, json_pack("{s:f, s:f, s:f, s:i, s:f}", "rotation_median_deg",
+                                            g->rot_median, "rotation_p90_deg", g->rot_p90,
+                                            "rotation_max_deg", g->rot_max, "over_5deg",
+                                            g->rot_over_5deg, "position_median", g->pos_median));
+    return j;
+}
+
+/* Matching again, all pairs, after an automatic choice gave a model that cannot be trusted
+ * (the pairs matched so far are reused). */
+static vf_status fall_back_to_all_pairs(poses_run *run)
+{
+    run->fallback = run->matcher;
+    run->matcher = "exhaustive";
+    vf_status status = vf__poses_match(run);
+    if (status == VF_OK)
+        status = vf__poses_map(run);
+    if (status == VF_OK)
+        status = check_registration(run);
+    return status;
+}
+
+/* Is the model to be trusted? Too few frames registered is an error (check_registration). A
+ * model from sequential or retrieval matching is then compared with all-pairs matching of a
+ * sample of its frames (vf__poses_check): a confidently wrong model registers every frame and
+ * looks fine by every count. When an automatic choice of matcher fails either test it falls
+ * back to all pairs; a matcher the user chose is an error. */
+static vf_status verify_model(poses_run *run)
+{
+    int chosen = strcmp(run->opt->matcher, "auto") != 0;
+    int exhaustive = !strcmp(run->matcher, "exhaustive");
+    if (run->model.image_count < run->opt->min_registered * run->frames.count) {
+        if (chosen || exhaustive)
+            return check_registration(run);
+        vf_warn("only %d of %d frames registered with %s matching; matching all pairs instead",
+                run->model.image_count, run->frames.count, run->matcher);
+        return fall_back_to_all_pairs(run);
+    }
+    if (!run->opt->check || exhaustive)
+        return VF_OK;
+    poses_check check;
+    vf_status status = vf__poses_check(run, &check);
+    if (status != VF_OK)
+        return status;
+    run->check = check_json(&check);
+    const vf_pose_agreement *g = &check.agreement;
+    if (!strcmp(check.verdict, "inconclusive")) {
+        vf_warn("registration check: only %d of %d sampled frames registered when matched all "
+                "pairs on their own; the model could not be checked",
+                check.registered, check.sampled);
+        return VF_OK;
+    }
+    if (!strcmp(check.verdict, "agrees")) {
+        vf_info("registration check: %d frames matched all pairs agree with the model "
+                "(rotations %.2f deg, positions %.2f%% of their spread off, medians)",
+                check.registered, g->rot_median, 100 * g->pos_median);
+        return VF_OK;
+    }
+    if (chosen)
+        return vf_fail(VF_EINPUT,
+                       "%s matching gave a model that disagrees with all-pairs matching of %d "
+                       "of its frames (rotations %.1f deg, positions %.1f%% of their spread "
+                       "off, medians): its poses are likely wrong; use --matcher exhaustive, "
+                       "or --no-check to keep it",
+                       run->matcher, check.registered, g->rot_median, 100 * g->pos_median);
+    vf_warn("registration check: the %s model disagrees with all-pairs matching of %d of its "
+            "frames (rotations %.1f deg, positions %.1f%% of their spread off, medians); "
+            "matching all pairs instead",
+            run->matcher, check.registered, g->rot_median, 100 * g->pos_median);
+    return fall_back_to_all_pairs(run);
 }
 
 /* The normalization of run->model, from its cameras and points. */
@@ -256,14 +337,18 @@ static json_t *unregistered_json(const poses_run *run)
 static json_t *summarize(const poses_run *run, const vf_normalization *norm)
 {
     const vf_colmap_model *m = &run->model;
-    return json_pack("{s:i, s:i, s:i, s:o, s:f, s:i, s:s, s:s, s:o, s:s, s:s, s:f, s:O}",
-                     "registered", m->image_count, "total", run->frames.count, "models",
-                     run->model_count, "unregistered", unregistered_json(run),
-                     "reprojection_error_px", vf_colmap_model_reprojection_error(m), "points",
-                     m->point_count, "matcher", run->matcher, "camera_model", run->camera_model,
-                     "cameras", cameras_json(m), "up_method", norm->up_method, "center_method",
-                     norm->center_method, "scale_to_object", norm->object_from_world.scale,
-                     "seconds", run->seconds);
+    json_t *j = json_pack("{s:i, s:i, s:i, s:o, s:f, s:i, s:s, s:s, s:o, s:s, s:s, s:f, s:O}",
+                          "registered", m->image_count, "total", run->frames.count, "models",
+                          run->model_count, "unregistered", unregistered_json(run),
+                          "reprojection_error_px", vf_colmap_model_reprojection_error(m), "points",
+                          m->point_count, "matcher", run->matcher, "camera_model",
+                          run->camera_model, "cameras", cameras_json(m), "up_method",
+                          norm->up_method, "center_method", norm->center_method, "scale_to_object",
+                          norm->object_from_world.scale, "seconds", run->seconds);
+    json_object_set(j, "check", run->check ? run->check : json_null());
+    if (run->fallback) /* the matcher first chosen, whose model was not trusted */
+        json_object_set_new(j, "fallback_from", json_string(run->fallback));
+    return j;
 }
 
 /* Everything inside the staging folder; *summary on success. */
@@ -291,7 +376,7 @@ static vf_status run_stage(poses_run *run, const vf_workspace *ws, json_t **summ
     choose_methods(run, source);
     if ((status = vf__poses_extract_features(run)) == VF_OK &&
         (status = vf__poses_match(run)) == VF_OK && (status = vf__poses_map(run)) == VF_OK &&
-        (status = check_registration(run)) == VF_OK)
+        (status = verify_model(run)) == VF_OK)
         status = export_outputs(run, &norm);
     if (status == VF_OK) {
         json_object_set_new(run->seconds, "total", json_real(vf_now() - run->stage.start_time));
@@ -341,10 +426,11 @@ vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **sum
         status = run_stage(&run, ws, summary);
     vf_colmap_close(&run.colmap);
     if (status == VF_OK) {
-        json_t *params = json_pack("{s:s, s:s, s:i, s:i, s:f, s:b}", "matcher", opt.matcher,
-                                   "camera_model", opt.camera_model, "overlap", opt.overlap,
-                                   "max_features", opt.max_features, "min_registered",
-                                   opt.min_registered, "known_intrinsics", opt.has_intrinsics);
+        json_t *params =
+            json_pack("{s:s, s:s, s:i, s:i, s:f, s:b, s:b}", "matcher", opt.matcher,
+                      "camera_model", opt.camera_model, "overlap", opt.overlap, "max_features",
+                      opt.max_features, "min_registered", opt.min_registered, "known_intrinsics",
+                      opt.has_intrinsics, "check", opt.check);
         status = vf_stage_commit(&run.stage, params, json_deep_copy(*summary));
     } else {
         status = keep_failure_log(&run, status);
@@ -357,5 +443,6 @@ vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **sum
     vf_colmap_model_free(&run.model);
     vf_sfm_images_free(&run.frames);
     json_decref(run.seconds);
+    json_decref(run.check);
     return status;
 }

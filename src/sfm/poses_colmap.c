@@ -10,13 +10,14 @@
 #include "poses_internal.h"
 #include "vf/log.h"
 
-/* Run one COLMAP command and record its wall time under its name (summed over repeats). */
+/* Run one COLMAP command and record its wall time under its name, or under "check" while
+ * run->checking (summed over repeats). */
 static vf_status run_step(poses_run *run, const char *label, vf_args *args)
 {
     double seconds = 0;
     vf_status status = vf_colmap_run(&run->colmap, label, (size_t)run->frames.count, args,
                                      &seconds);
-    const char *name = args->count ? args->items[0] : "colmap";
+    const char *name = run->checking ? "check" : args->count ? args->items[0] : "colmap";
     json_t *before = json_object_get(run->seconds, name);
     json_object_set_new(run->seconds, name, json_real(seconds + json_number_value(before)));
     vf_args_free(args);
@@ -114,19 +115,25 @@ vf_status vf__poses_match(poses_run *run)
                     &a);
 }
 
-static vf_status run_mapper(poses_run *run, const char *output)
+/* Map into `output`; only the images named in image_list when it is not NULL. */
+static vf_status run_mapper(poses_run *run, const char *output, const char *image_list)
 {
     vf_args a = {0};
     vf_args_add(&a, "mapper");
     vf_args_opt(&a, "--database_path", "%s", run->database);
     vf_args_opt(&a, "--image_path", "%s", run->images);
     vf_args_opt(&a, "--output_path", "%s", output);
+    if (image_list)
+        vf_args_opt(&a, "--image_list_path", "%s", image_list);
     if (run->opt->has_intrinsics) {
         vf_args_opt(&a, "--Mapper.ba_refine_focal_length", "0");
         vf_args_opt(&a, "--Mapper.ba_refine_principal_point", "0");
         vf_args_opt(&a, "--Mapper.ba_refine_extra_params", "0");
     }
-    return run_step(run, "COLMAP: registering frames", &a);
+    return run_step(run,
+                    image_list ? "COLMAP: checking (registering the sample)"
+                               : "COLMAP: registering frames",
+                    &a);
 }
 
 static vf_status convert_to_text(poses_run *run, const char *input, const char *output)
@@ -152,35 +159,43 @@ static int is_number(const char *name)
     return 1;
 }
 
-/* Load model `name` (a numbered folder under sparse_dir) and keep it when it registers more
- * images than run->model. */
-static vf_status consider_model(poses_run *run, const char *sparse_dir, const char *name)
+/* The models COLMAP wrote under sparse_dir (numbered folders), each converted to text under
+ * text_root: the one with the most images (then points) in *best, its binary folder in
+ * best_dir, how many there were in *count. None leaves *best empty. */
+static vf_status load_largest_model(poses_run *run, const char *sparse_dir, const char *text_root,
+                                    vf_colmap_model *best, char best_dir[VF_PATH_MAX], int *count)
 {
-    char bin[VF_PATH_MAX], txt[VF_PATH_MAX], txt_root[VF_PATH_MAX];
-    vf_colmap_model model;
-    vf_status status = vf_path_join(bin, sizeof bin, sparse_dir, name);
-    if (status == VF_OK)
-        status = vf_path_join(txt_root, sizeof txt_root, run->scratch, "text");
-    if (status == VF_OK)
-        status = vf_path_join(txt, sizeof txt, txt_root, name);
-    if (status == VF_OK)
-        status = convert_to_text(run, bin, txt);
-    if (status == VF_OK)
-        status = vf_colmap_model_load(txt, &model);
-    if (status != VF_OK)
-        return status;
-    run->model_count++;
-    int better = model.image_count > run->model.image_count ||
-                 (model.image_count == run->model.image_count &&
-                  model.point_count > run->model.point_count);
-    if (!better) {
-        vf_colmap_model_free(&model);
-        return VF_OK;
+    DIR *dir = opendir(sparse_dir);
+    if (!dir)
+        return vf_fail(VF_EINTERNAL, "cannot open %s: %s", sparse_dir, strerror(errno));
+    vf_status status = VF_OK;
+    struct dirent *entry;
+    while (status == VF_OK && (entry = readdir(dir))) {
+        if (!is_number(entry->d_name))
+            continue;
+        char bin[VF_PATH_MAX], txt[VF_PATH_MAX];
+        vf_colmap_model model;
+        status = vf_path_join(bin, VF_PATH_MAX, sparse_dir, entry->d_name);
+        if (status == VF_OK)
+            status = vf_path_join(txt, sizeof txt, text_root, entry->d_name);
+        if (status == VF_OK)
+            status = convert_to_text(run, bin, txt);
+        if (status == VF_OK)
+            status = vf_colmap_model_load(txt, &model);
+        if (status != VF_OK)
+            break;
+        (*count)++;
+        if (model.image_count > best->image_count ||
+            (model.image_count == best->image_count && model.point_count > best->point_count)) {
+            vf_colmap_model_free(best);
+            *best = model;
+            snprintf(best_dir, VF_PATH_MAX, "%s", bin);
+        } else {
+            vf_colmap_model_free(&model);
+        }
     }
-    vf_colmap_model_free(&run->model);
-    run->model = model;
-    snprintf(run->model_dir, sizeof run->model_dir, "%s", bin);
-    return VF_OK;
+    closedir(dir);
+    return status;
 }
 
 /* Move the chosen model's text files to stage/sparse. */
@@ -200,29 +215,149 @@ static vf_status keep_model_text(poses_run *run)
 
 vf_status vf__poses_map(poses_run *run)
 {
-    char sparse[VF_PATH_MAX];
+    char sparse[VF_PATH_MAX], text[VF_PATH_MAX];
+    vf_colmap_model_free(&run->model); /* a second mapping (the check's fallback) starts over */
+    run->model_count = 0;
     vf_status status = vf_path_join(sparse, sizeof sparse, run->scratch, "sparse");
+    if (status == VF_OK)
+        status = vf_path_join(text, sizeof text, run->scratch, "text");
+    if (status == VF_OK)
+        status = vf_remove_tree(sparse);
+    if (status == VF_OK)
+        status = vf_remove_tree(text);
     if (status == VF_OK)
         status = vf_mkdirs(sparse);
     if (status != VF_OK)
         return status;
     /* The mapper exits 1 ("failed to create sparse model") when no pair of frames starts a
      * model: the input's fault, which the registration check reports (0 registered). */
-    status = run_mapper(run, sparse);
+    status = run_mapper(run, sparse, NULL);
     if (status != VF_OK && run->colmap.last_exit != 1)
         return status;
-    status = VF_OK;
-    DIR *dir = opendir(sparse);
-    if (!dir)
-        return vf_fail(VF_EINTERNAL, "cannot open %s: %s", sparse, strerror(errno));
-    struct dirent *entry;
-    while (status == VF_OK && (entry = readdir(dir)))
-        if (is_number(entry->d_name))
-            status = consider_model(run, sparse, entry->d_name);
-    closedir(dir);
+    status = load_largest_model(run, sparse, text, &run->model, run->model_dir, &run->model_count);
     if (status == VF_OK && run->model.image_count > 0)
         status = keep_model_text(run);
     return status;
+}
+
+/* The check's sample: up to CHECK_FRAMES registered images spread evenly over the model's
+ * list, as indices into run->model.images. */
+static int check_sample(const poses_run *run, int sample[CHECK_FRAMES])
+{
+    int n = run->model.image_count, k = n < CHECK_FRAMES ? n : CHECK_FRAMES;
+    for (int i = 0; i < k; i++)
+        sample[i] = (int)((long)i * n / k);
+    return k;
+}
+
+/* The sample's names (image list) and all its pairs (match list) as COLMAP reads them. */
+static vf_status write_check_lists(const poses_run *run, const int *sample, int k,
+                                   const char *list, const char *pairs)
+{
+    FILE *lf = fopen(list, "w"), *pf = fopen(pairs, "w");
+    for (int i = 0; lf && pf && i < k; i++) {
+        fprintf(lf, "%s\n", run->model.images[sample[i]].name);
+        for (int j = i + 1; j < k; j++)
+            fprintf(pf, "%s %s\n", run->model.images[sample[i]].name,
+                    run->model.images[sample[j]].name);
+    }
+    int ok = lf && pf && !ferror(lf) && !ferror(pf);
+    ok &= (lf && fclose(lf) == 0) & (pf && fclose(pf) == 0);
+    return ok ? VF_OK : vf_fail(VF_EINTERNAL, "cannot write %s: %s", list, strerror(errno));
+}
+
+/* Our poses of the check model's images beside its own, compared. */
+static vf_status compare_check(const poses_run *run, const vf_colmap_model *check,
+                               poses_check *out)
+{
+    int n = 0;
+    double(*ours)[16] = malloc(sizeof *ours * (size_t)(check->image_count + 1));
+    double(*theirs)[16] = malloc(sizeof *theirs * (size_t)(check->image_count + 1));
+    const double **a = malloc(sizeof *a * (size_t)(check->image_count + 1));
+    const double **b = malloc(sizeof *b * (size_t)(check->image_count + 1));
+    vf_status status = ours && theirs && a && b ? VF_OK : vf_fail(VF_EINTERNAL, "out of memory");
+    for (int i = 0; status == VF_OK && i < check->image_count; i++)
+        for (int j = 0; j < run->model.image_count; j++)
+            if (!strcmp(check->images[i].name, run->model.images[j].name)) {
+                vf_colmap_image_c2w(&run->model.images[j], ours[n]);
+                vf_colmap_image_c2w(&check->images[i], theirs[n]);
+                a[n] = ours[n];
+                b[n] = theirs[n];
+                n++;
+                break;
+            }
+    out->registered = n;
+    if (status == VF_OK && n >= 3)
+        status = vf_pose_compare(a, b, n, 0, &out->agreement);
+    free(ours);
+    free(theirs);
+    free(a);
+    free(b);
+    return status;
+}
+
+static vf_status check_model(poses_run *run, poses_check *out);
+
+vf_status vf__poses_check(poses_run *run, poses_check *out)
+{
+    double start = vf_now();
+    run->checking = 1;
+    vf_status status = check_model(run, out);
+    run->checking = 0;
+    out->seconds = vf_now() - start;
+    return status;
+}
+
+static vf_status check_model(poses_run *run, poses_check *out)
+{
+    *out = (poses_check){.verdict = "inconclusive"};
+    int sample[CHECK_FRAMES];
+    int k = check_sample(run, sample);
+    out->sampled = k;
+    char dir[VF_PATH_MAX], sparse[VF_PATH_MAX], text[VF_PATH_MAX], list[VF_PATH_MAX],
+        pairs[VF_PATH_MAX];
+    vf_status status = vf_path_join(dir, sizeof dir, run->scratch, "check");
+    if (status == VF_OK)
+        status = vf_path_join(sparse, sizeof sparse, dir, "sparse");
+    if (status == VF_OK)
+        status = vf_path_join(text, sizeof text, dir, "text");
+    if (status == VF_OK)
+        status = vf_path_join(list, sizeof list, dir, "images.txt");
+    if (status == VF_OK)
+        status = vf_path_join(pairs, sizeof pairs, dir, "pairs.txt");
+    if (status == VF_OK)
+        status = vf_mkdirs(sparse);
+    if (status == VF_OK)
+        status = write_check_lists(run, sample, k, list, pairs);
+    if (status != VF_OK)
+        return status;
+    vf_args a = {0};
+    vf_args_add(&a, "matches_importer"); /* pairs matched already are kept, not redone */
+    vf_args_opt(&a, "--database_path", "%s", run->database);
+    vf_args_opt(&a, "--match_list_path", "%s", pairs);
+    vf_args_opt(&a, "--match_type", "pairs");
+    vf_args_opt(&a, "--SiftMatching.use_gpu", "0");
+    status = run_step(run, "COLMAP: checking (all pairs of a sample)", &a);
+    if (status == VF_OK) {
+        status = run_mapper(run, sparse, list);
+        if (status != VF_OK && run->colmap.last_exit == 1)
+            return VF_OK; /* no model from the sample: inconclusive */
+    }
+    vf_colmap_model check = {0};
+    char check_dir[VF_PATH_MAX] = "";
+    int models = 0;
+    if (status == VF_OK)
+        status = load_largest_model(run, sparse, text, &check, check_dir, &models);
+    if (status == VF_OK && check.image_count >= 3)
+        status = compare_check(run, &check, out);
+    vf_colmap_model_free(&check);
+    if (status != VF_OK || out->registered < (k + 1) / 2 || out->registered < 3)
+        return status; /* too few of the sample re-registered to judge */
+    const vf_pose_agreement *g = &out->agreement;
+    int bad = g->rot_median > CHECK_MAX_ROTATION_DEG || 5 * g->rot_over_5deg > g->count ||
+              g->pos_median > CHECK_MAX_POSITION;
+    out->verdict = bad ? "disagrees" : "agrees";
+    return VF_OK;
 }
 
 /* Drop what image_undistorter writes for dense stereo; only the images are needed. */
