@@ -1,7 +1,8 @@
 /* Ingest on real captures: the 50 fox photos made into a sideways phone video with a rotation
  * flag (frames must come out upright and match the photos), a video with known blurred and
  * repeated frames (exactly those are rejected), and photo folders (the spray can's RGBA
- * photos on white; a folder mixing portrait and landscape). The videos are made with the
+ * photos on white; a folder mixing portrait and landscape), and a real RGBA frame decoded. The
+ * videos are made with the
  * ffmpeg command line inside the test. */
 #include <stdlib.h>
 #include <string.h>
@@ -9,6 +10,7 @@
 
 #include "check.h"
 #include "vf/fsutil.h"
+#include "vf/image.h"
 #include "vf/ingest.h"
 #include "vf/log.h"
 #include "vf/rgb8.h"
@@ -275,6 +277,28 @@ static void test_mixed_orientation(void)
     json_decref(report);
 }
 
+/* A real third-party RGBA frame (NeRF-synthetic, Lanczos-resized PNG) decodes as RGBA with
+ * a transparent background, and composited onto white as RGB. */
+static void test_real_frame(void)
+{
+    const char *path = vf_test_shared("data/nerf_synthetic/chair/train/r_0.png");
+    vf_image img = {0}, rgb = {0};
+    CHECK(vf_image_load(path, &img) == VF_OK, "load %s: %s", path, vf_error_message());
+    CHECK(img.width == 200 && img.height == 200 && img.channels == 4, "chair frame %dx%dx%d",
+          img.width, img.height, img.channels);
+    CHECK(vf_image_load_rgb(path, (float[3]){1, 1, 1}, &rgb) == VF_OK, "load rgb");
+    if (img.data && rgb.data) {
+        CHECK(img.data[3] == 0.0f, "corner is transparent");
+        CHECK(rgb.data[0] == 1.0f && rgb.data[2] == 1.0f, "corner is white");
+        int opaque = 0;
+        for (int i = 0; i < 200 * 200; i++)
+            opaque += img.data[4 * i + 3] > 0.99f;
+        CHECK(opaque > 2000 && opaque < 30000, "%d opaque chair pixels", opaque);
+    }
+    vf_image_free(&rgb);
+    vf_image_free(&img);
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
@@ -284,6 +308,7 @@ int main(int argc, char **argv)
     CHECK(photo_count == 50, "50 fox photos, found %d", photo_count);
     if (photo_count != 50)
         return check_finish();
+    CHECK_CASE(test_real_frame);
     CHECK_CASE(test_rotated_video);
     CHECK_CASE(test_blurred_and_still_frames);
     CHECK_CASE(test_photo_folder);

@@ -231,26 +231,6 @@ static void test_errors(void)
     vf_image_free(&small);
 }
 
-static void test_real_frame(void)
-{
-    const char *path = vf_test_shared("data/nerf_synthetic/chair/train/r_0.png");
-    vf_image img = {0}, rgb = {0};
-    CHECK(vf_image_load(path, &img) == VF_OK, "load %s: %s", path, vf_error_message());
-    CHECK(img.width == 200 && img.height == 200 && img.channels == 4, "chair frame %dx%dx%d",
-          img.width, img.height, img.channels);
-    CHECK(vf_image_load_rgb(path, (float[3]){1, 1, 1}, &rgb) == VF_OK, "load rgb");
-    if (img.data && rgb.data) {
-        CHECK(pixel(&img, 0, 0)[3] == 0.0f, "corner is transparent");
-        CHECK(pixel(&rgb, 0, 0)[0] == 1.0f && pixel(&rgb, 0, 0)[2] == 1.0f, "corner is white");
-        int opaque = 0;
-        for (int i = 0; i < 200 * 200; i++)
-            opaque += img.data[4 * i + 3] > 0.99f;
-        CHECK(opaque > 2000 && opaque < 30000, "%d opaque chair pixels", opaque);
-    }
-    vf_image_free(&rgb);
-    vf_image_free(&img);
-}
-
 /* The inverse of each EXIF orientation, and what 6 and 5 mean on a 3 x 2 image. */
 static void test_reorient(void)
 {
@@ -345,6 +325,5 @@ int main(int argc, char **argv)
     CHECK_CASE(test_reorient);
     CHECK_CASE(test_exif_orientation);
     CHECK_CASE(test_errors);
-    CHECK_CASE(test_real_frame);
     return check_finish();
 }

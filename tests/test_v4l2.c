@@ -3,6 +3,7 @@
  * images, errors for missing and unsuitable devices, and a whole webcam ingest. */
 #include "v4l2_fake.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -44,15 +45,26 @@ static void rgb_to_yuyv(const vf_rgb8 *img, unsigned char *out)
         }
 }
 
-/* Five real frames: NeRF-synthetic chair views on white, as YUYV and as MJPEG. */
+/* Five frames of a camera panning over a colourful pattern (smooth enough for YUYV's shared
+ * chroma and for JPEG, detailed enough to be sharp), as RGB, YUYV and MJPEG. */
 static int load_recording(void)
 {
+    enum { W = 200, H = 160 };
+    const double tau = 6.283185307179586;
     for (int i = 0; i < FRAMES; i++) {
-        char rel[64];
-        snprintf(rel, sizeof rel, "data/nerf_synthetic/chair/train/r_%d.png", 10 * i);
-        if (vf_rgb8_load(vf_test_shared(rel), &sources[i]) != VF_OK)
+        if (vf_rgb8_resize_buffer(&sources[i], W, H) != VF_OK)
             return -1;
-        yuyv[i] = malloc((size_t)sources[i].width * sources[i].height * 2);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                unsigned char *p = sources[i].data + ((size_t)y * W + x) * 3;
+                double u = x + 7.0 * i; /* the pan */
+                p[0] = to_byte(128 + 80 * sin(tau * u / 53) * cos(tau * y / 67));
+                p[1] = to_byte(128 + 80 * sin(tau * (y + 0.3 * u) / 29));
+                p[2] = to_byte(128 + 60 * cos(tau * (u + y) / 89));
+            }
+        yuyv[i] = malloc((size_t)W * H * 2);
+        if (!yuyv[i])
+            return -1;
         rgb_to_yuyv(&sources[i], yuyv[i]);
         if (vf_rgb8_encode_jpeg(&sources[i], 90, &mjpeg[i], &mjpeg_size[i]) != VF_OK)
             return -1;
