@@ -184,30 +184,35 @@ def setup_scene():
 
 
 def textured_material(name, scale, colors):
-    """A procedural material with corners at every scale (bricks over noise): real texture
-    for SIFT, the same from every view."""
+    """A procedural material that looks different everywhere (multi-scale noise over Voronoi
+    cells, like stone): corners for SIFT at every scale, and none of the repetition of tiles
+    or bricks, whose copies SIFT cannot tell apart."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
     bsdf = nodes["Principled BSDF"]
     bsdf.inputs["Roughness"].default_value = 0.8
     coords = nodes.new("ShaderNodeTexCoord")
-    bricks = nodes.new("ShaderNodeTexBrick")
-    bricks.inputs["Scale"].default_value = scale
-    bricks.inputs["Mortar Size"].default_value = 0.03
     noise = nodes.new("ShaderNodeTexNoise")
-    noise.inputs["Scale"].default_value = scale * 4
+    noise.inputs["Scale"].default_value = scale
     noise.inputs["Detail"].default_value = 6
-    links.new(coords.outputs["Object"], bricks.inputs["Vector"])
+    noise.inputs["Roughness"].default_value = 0.65
+    cells = nodes.new("ShaderNodeTexVoronoi")
+    cells.inputs["Scale"].default_value = scale * 3
     links.new(coords.outputs["Object"], noise.inputs["Vector"])
+    links.new(coords.outputs["Object"], cells.inputs["Vector"])
+    mix = nodes.new("ShaderNodeMath")
+    mix.operation = "MULTIPLY_ADD"  # noise * 0.7 + cell distance
+    mix.inputs[1].default_value = 0.7
+    links.new(noise.outputs["Fac"], mix.inputs[0])
+    links.new(cells.outputs["Distance"], mix.inputs[2])
     ramp = nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].position = 0.3
     ramp.color_ramp.elements[0].color = colors[0]
+    ramp.color_ramp.elements[1].position = 1.0
     ramp.color_ramp.elements[1].color = colors[1]
-    links.new(noise.outputs["Fac"], ramp.inputs["Fac"])
-    links.new(ramp.outputs["Color"], bricks.inputs["Color1"])
-    bricks.inputs["Color2"].default_value = colors[2]
-    bricks.inputs["Mortar"].default_value = colors[3]
-    links.new(bricks.outputs["Color"], bsdf.inputs["Base Color"])
+    links.new(mix.outputs["Value"], ramp.inputs["Fac"])
+    links.new(ramp.outputs["Color"], bsdf.inputs["Base Color"])
     return mat
 
 
@@ -217,14 +222,12 @@ def add_room(scene, floor_z):
     bpy.ops.mesh.primitive_plane_add(size=30.0, location=(0, 0, floor_z))
     floor = bpy.context.active_object
     floor.data.materials.append(textured_material(
-        "vf_floor", 6.0, [(0.35, 0.22, 0.12, 1), (0.75, 0.55, 0.35, 1), (0.55, 0.4, 0.3, 1),
-                          (0.1, 0.08, 0.06, 1)]))
+        "vf_floor", 1.5, [(0.15, 0.1, 0.06, 1), (0.85, 0.65, 0.45, 1)]))
     bpy.ops.mesh.primitive_cylinder_add(vertices=64, radius=12.0, depth=16.0, end_fill_type="NOTHING",
                                         location=(0, 0, floor_z + 8.0))
     wall = bpy.context.active_object
     wall.data.materials.append(textured_material(
-        "vf_wall", 3.0, [(0.5, 0.55, 0.6, 1), (0.85, 0.85, 0.8, 1), (0.3, 0.35, 0.45, 1),
-                         (0.95, 0.95, 0.95, 1)]))
+        "vf_wall", 0.8, [(0.25, 0.3, 0.4, 1), (0.9, 0.9, 0.85, 1)]))
     scene.render.film_transparent = False
     scene.render.image_settings.color_mode = "RGB"
     scene.cycles.max_bounces = 3  # diffuse walls: more bounces cost time, not features

@@ -198,7 +198,8 @@ static vf_status load_largest_model(poses_run *run, const char *sparse_dir, cons
     return status;
 }
 
-/* Move the chosen model's text files to stage/sparse. */
+/* Move the chosen model's text files to stage/sparse (replacing those of an earlier mapping
+ * of this run: the check's fallback maps again). */
 static vf_status keep_model_text(poses_run *run)
 {
     char name[256], text[VF_PATH_MAX], from[VF_PATH_MAX], to[VF_PATH_MAX];
@@ -208,6 +209,8 @@ static vf_status keep_model_text(poses_run *run)
         status = vf_path_join(from, sizeof from, text, name);
     if (status == VF_OK)
         status = vf_path_join(to, sizeof to, run->stage.dir, "sparse");
+    if (status == VF_OK)
+        status = vf_remove_tree(to);
     if (status == VF_OK && rename(from, to) != 0)
         status = vf_fail(VF_EINTERNAL, "cannot move %s to %s: %s", from, to, strerror(errno));
     return status;
