@@ -220,7 +220,7 @@ static vf_status verify_model(poses_run *run)
     const vf_pose_agreement *g = &check.agreement;
     if (!strcmp(check.verdict, "inconclusive")) {
         vf_warn("registration check: only %d of %d sampled frames registered when matched all "
-                "pairs on their own; the model could not be checked",
+                "pairs on their own (too far apart); the model could not be checked",
                 check.registered, check.sampled);
         return VF_OK;
     }

@@ -354,8 +354,8 @@ static vf_status check_model(poses_run *run, poses_check *out)
     if (status == VF_OK && check.image_count >= 3)
         status = compare_check(run, &check, out);
     vf_colmap_model_free(&check);
-    if (status != VF_OK || out->registered < (k + 1) / 2 || out->registered < 3)
-        return status; /* too few of the sample re-registered to judge */
+    if (status != VF_OK || 4 * out->registered < 3 * k || out->registered < 3)
+        return status; /* too few of the sample re-registered for it to be a reference */
     const vf_pose_agreement *g = &out->agreement;
     int bad = g->rot_median > CHECK_MAX_ROTATION_DEG || 5 * g->rot_over_5deg > g->count ||
               g->pos_median > CHECK_MAX_POSITION;

@@ -54,7 +54,9 @@ vf_status vf__poses_match(poses_run *run);
  * files in stage/sparse. No model at all leaves run->model empty (0 images). */
 vf_status vf__poses_map(poses_run *run);
 /* The registration check of run->model; verdict "agrees", "disagrees" or "inconclusive"
- * (fewer than half the sample registered on its own). Adds the sample's pairs to the
+ * (fewer than 3/4 of the sample registered on its own: its frames are too far apart for
+ * their own model to be a reference; measured on 100 rendered views spread over a
+ * hemisphere, 11 of 16 registered into a wrong model, 158 deg off a right one). Adds the sample's pairs to the
  * database, which a later exhaustive matching then reuses. */
 typedef struct poses_check {
     int sampled, registered; /* frames in the sample; of them, registered on their own */
