@@ -20,7 +20,7 @@ static const char usage[] =
     "                        frames are: up to 40 frames, all pairs (exhaustive); frames of a\n"
     "                        video or webcam are in capture order, so each is matched with its\n"
     "                        neighbours (sequential); a photo folder has no\n"
-    "                        order (file names say nothing), so all pairs up to 150 photos, and\n"
+    "                        order (file names say nothing), so all pairs up to 80 photos, and\n"
     "                        beyond that the most similar images by a vocabulary tree built from\n"
     "                        the capture's own features (retrieval)\n"
     "      --no-check        keep a sequential or retrieval model unchecked. By default 16 of\n"

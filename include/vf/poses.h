@@ -11,7 +11,7 @@
  *
  * The "auto" matcher chooses by what the frames are (the ingest report says): up to 40
  * frames, all pairs; frames of a video or webcam, in capture order, sequential; a photo
- * folder, whose file names say nothing about where the photos were taken, all pairs up to 150
+ * folder, whose file names say nothing about where the photos were taken, all pairs up to 80
  * photos and beyond that retrieval (each photo with its 40 most similar by a vocabulary tree
  * built from the capture's own features). A model from sequential or retrieval matching is
  * then checked: 16 of its frames, matched all pairs with each other and registered on their
