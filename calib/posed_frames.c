@@ -5,15 +5,8 @@
 vf_status vf__calib_load_posed_frames(const vf_workspace *ws, vf_dataset *out)
 {
     char path[VF_PATH_MAX];
-    const char *stage = vf_workspace_has_stage(ws, "poses") ? "poses" : "ingest";
-    vf_status status = vf_workspace_path(ws, stage, "transforms.json", path, sizeof path);
-    if (status != VF_OK)
-        return status;
-    if (!vf_workspace_has_stage(ws, stage) || !vf_is_file(path))
-        return vf_fail(VF_EINPUT, "workspace %s has no posed frames: run 'vfcapture poses %s' "
-                                  "first",
-                       ws->root, ws->root);
-    return vf_dataset_load(path, out);
+    vf_status status = vf_workspace_posed_frames(ws, path, sizeof path);
+    return status == VF_OK ? vf_dataset_load(path, out) : status;
 }
 
 void vf__calib_frame_ray(const vf_frame *frame, double u, double v, double origin[3],

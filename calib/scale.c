@@ -8,6 +8,8 @@
 #include "vf/log.h"
 #include "vf/pose.h"
 
+#define SCALE_FILE "scale.json" /* in WS/calib */
+
 #define MAX_MARKERS_PER_FRAME 64
 
 /* One point seen in several frames: frame index and pixel per sighting. */
@@ -243,7 +245,7 @@ int vf_workspace_metres_per_unit(const vf_workspace *ws, double *metres_per_unit
     char path[VF_PATH_MAX];
     json_t *doc;
     if (!vf_workspace_has_stage(ws, "calib") ||
-        vf_workspace_path(ws, "calib", "scale.json", path, sizeof path) != VF_OK ||
+        vf_workspace_path(ws, "calib", SCALE_FILE, path, sizeof path) != VF_OK ||
         !vf_is_file(path) || vf_json_load(path, &doc) != VF_OK) {
         vf_error_clear();
         return 0;
@@ -254,4 +256,59 @@ int vf_workspace_metres_per_unit(const vf_workspace *ws, double *metres_per_unit
         return 0;
     *metres_per_unit = s;
     return 1;
+}
+
+#define MAX_PICKS 64
+
+static vf_status measure(const vf_scale_request *r, const vf_workspace *ws, double *s,
+                         json_t **details)
+{
+    if (!r->p1)
+        return vf_scale_from_marker(ws, r->marker, r->size_m, s, details);
+    vf_pick p1[MAX_PICKS], p2[MAX_PICKS];
+    int n1, n2;
+    vf_status status = vf_parse_picks(r->p1, p1, MAX_PICKS, &n1);
+    if (status == VF_OK)
+        status = vf_parse_picks(r->p2, p2, MAX_PICKS, &n2);
+    if (status == VF_OK)
+        status = vf_scale_from_picks(ws, p1, n1, p2, n2, r->distance_m, s, details);
+    return status;
+}
+
+vf_status vf_calib_scale_run(const char *ws_root, const vf_scale_request *r, json_t **result)
+{
+    *result = NULL;
+    vf_workspace ws;
+    vf_status status = vf_workspace_open(ws_root, 0, &ws);
+    if (status != VF_OK)
+        return status;
+    double s = 0;
+    json_t *details = NULL, *doc = NULL;
+    const char *method = r->p1 ? "distance" : "marker";
+    vf_stage stage;
+    char path[VF_PATH_MAX];
+    status = measure(r, &ws, &s, &details);
+    if (status == VF_OK) {
+        doc = json_pack("{s:f, s:f, s:s, s:o}", "metres_per_unit", s, "units_per_metre", 1.0 / s,
+                        "method", method, "details", details);
+        status = vf_stage_begin(&ws, "calib", &stage);
+    } else {
+        json_decref(details);
+    }
+    if (status == VF_OK) {
+        status = vf_path_join(path, sizeof path, stage.dir, SCALE_FILE);
+        if (status == VF_OK)
+            status = vf_json_save(path, doc);
+        if (status == VF_OK)
+            status = vf_stage_commit(&stage, json_pack("{s:s}", "method", method),
+                                     json_pack("{s:f}", "metres_per_unit", s));
+        else
+            vf_stage_abort(&stage);
+    }
+    vf_workspace_close(&ws);
+    if (status == VF_OK)
+        *result = doc;
+    else
+        json_decref(doc);
+    return status;
 }

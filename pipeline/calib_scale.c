@@ -6,8 +6,6 @@
 #include "calib_cmd.h"
 #include "vf/log.h"
 
-#define MAX_PICKS 64
-
 static const char usage[] =
     "usage: vfcapture calib scale WS (--marker ID --size MM | --distance P1 P2 MM)\n"
     "\n"
@@ -33,9 +31,7 @@ enum { OPT_MARKER = CLI_OPT_FIRST_CUSTOM, OPT_SIZE, OPT_DISTANCE };
 
 typedef struct scale_args {
     const char *workspace;
-    long marker;
-    double size_m, distance_m;
-    const char *p1, *p2;
+    vf_scale_request req;
 } scale_args;
 
 static vf_status parse_args(int argc, char **argv, scale_args *a, cli_flags *flags)
@@ -47,7 +43,8 @@ static vf_status parse_args(int argc, char **argv, scale_args *a, cli_flags *fla
         {"distance", required_argument, NULL, OPT_DISTANCE},
         {0, 0, 0, 0},
     };
-    *a = (scale_args){.marker = -1};
+    *a = (scale_args){.req.marker = -1};
+    long marker = -1;
     int c;
     vf_status status;
     while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT, longopts, NULL)) != -1) {
@@ -55,20 +52,21 @@ static vf_status parse_args(int argc, char **argv, scale_args *a, cli_flags *fla
             continue;
         switch (c) {
         case OPT_MARKER:
-            if (cli_parse_int(optarg, 0, VF_ARUCO_IDS - 1, &a->marker))
+            if (cli_parse_int(optarg, 0, VF_ARUCO_IDS - 1, &marker))
                 return vf_fail(VF_EINPUT, "--marker: give an ArUco id from 0 to %d",
                                VF_ARUCO_IDS - 1);
+            a->req.marker = (int)marker;
             break;
         case OPT_SIZE:
-            if ((status = calib_parse_mm(optarg, "--size", &a->size_m)) != VF_OK)
+            if ((status = calib_parse_mm(optarg, "--size", &a->req.size_m)) != VF_OK)
                 return status;
             break;
         case OPT_DISTANCE: /* three values: P1 (optarg), then P2 and MM */
             if (optind + 1 >= argc)
                 return vf_fail(VF_EINPUT, "--distance takes three values: P1 P2 MM");
-            a->p1 = optarg;
-            a->p2 = argv[optind];
-            if ((status = calib_parse_mm(argv[optind + 1], "--distance", &a->distance_m)) !=
+            a->req.p1 = optarg;
+            a->req.p2 = argv[optind];
+            if ((status = calib_parse_mm(argv[optind + 1], "--distance", &a->req.distance_m)) !=
                 VF_OK)
                 return status;
             optind += 2;
@@ -79,61 +77,13 @@ static vf_status parse_args(int argc, char **argv, scale_args *a, cli_flags *fla
         return vf_fail(VF_EINPUT, "give one workspace folder (see 'vfcapture calib scale "
                                   "--help')");
     a->workspace = argv[optind];
-    int by_marker = a->marker >= 0 || a->size_m > 0, by_distance = a->p1 != NULL;
+    int by_marker = a->req.marker >= 0 || a->req.size_m > 0, by_distance = a->req.p1 != NULL;
     if (by_marker == by_distance)
         return vf_fail(VF_EINPUT, "give either --marker ID --size MM or --distance P1 P2 MM");
-    if (by_marker && (a->marker < 0 || !(a->size_m > 0)))
+    if (by_marker && (a->req.marker < 0 || !(a->req.size_m > 0)))
         return vf_fail(VF_EINPUT, "--marker needs --size MM (the side of the black square) and "
                                   "--size needs --marker ID");
     return VF_OK;
-}
-
-static vf_status measure(const scale_args *a, const vf_workspace *ws, double *s, json_t **details)
-{
-    if (a->p1) {
-        vf_pick p1[MAX_PICKS], p2[MAX_PICKS];
-        int n1, n2;
-        vf_status status = vf_parse_picks(a->p1, p1, MAX_PICKS, &n1);
-        if (status == VF_OK)
-            status = vf_parse_picks(a->p2, p2, MAX_PICKS, &n2);
-        if (status == VF_OK)
-            status = vf_scale_from_picks(ws, p1, n1, p2, n2, a->distance_m, s, details);
-        return status;
-    }
-    return vf_scale_from_marker(ws, (int)a->marker, a->size_m, s, details);
-}
-
-static vf_status run(const scale_args *a, json_t **result)
-{
-    vf_workspace ws;
-    vf_status status = vf_workspace_open(a->workspace, 0, &ws);
-    if (status != VF_OK)
-        return status;
-    double s = 0;
-    json_t *details = NULL;
-    vf_stage stage;
-    char path[VF_PATH_MAX];
-    status = measure(a, &ws, &s, &details);
-    if (status == VF_OK) {
-        *result = json_pack("{s:f, s:f, s:s, s:o}", "metres_per_unit", s, "units_per_metre",
-                            1.0 / s, "method", a->p1 ? "distance" : "marker", "details", details);
-        status = vf_stage_begin(&ws, "calib", &stage);
-    } else {
-        json_decref(details);
-    }
-    if (status == VF_OK) {
-        status = vf_path_join(path, sizeof path, stage.dir, "scale.json");
-        if (status == VF_OK)
-            status = vf_json_save(path, *result);
-        if (status == VF_OK)
-            status = vf_stage_commit(&stage, json_pack("{s:s}", "method", a->p1 ? "distance"
-                                                                                : "marker"),
-                                     json_pack("{s:f}", "metres_per_unit", s));
-        else
-            vf_stage_abort(&stage);
-    }
-    vf_workspace_close(&ws);
-    return status;
 }
 
 int calib_scale(int argc, char **argv)
@@ -143,7 +93,7 @@ int calib_scale(int argc, char **argv)
     json_t *result = NULL;
     vf_status status = parse_args(argc, argv, &a, &flags);
     if (status == VF_OK)
-        status = run(&a, &result);
+        status = vf_calib_scale_run(a.workspace, &a.req, &result);
     if (status != VF_OK) {
         json_decref(result);
         return cli_fail("calib scale", status);
@@ -155,7 +105,7 @@ int calib_scale(int argc, char **argv)
     }
     double s = json_number_value(json_object_get(result, "metres_per_unit"));
     printf("1 scene unit = %.4f m (%.2f units per metre), by %s\n", s, 1.0 / s,
-           a.p1 ? "two picked points" : "the marker");
+           a.req.p1 ? "two picked points" : "the marker");
     printf("scale in %s/calib/scale.json\n", a.workspace);
     json_decref(result);
     return 0;

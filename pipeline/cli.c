@@ -87,6 +87,44 @@ int cli_parse_int(const char *text, long lo, long hi, long *out)
     return 0;
 }
 
+vf_status cli_count(const char *option, const char *text, long lo, long hi, long *out)
+{
+    if (cli_parse_int(text, lo, hi, out))
+        return vf_fail(VF_EINPUT, "%s wants a whole number from %ld to %ld, not '%s'", option, lo,
+                       hi, text);
+    return VF_OK;
+}
+
+vf_status cli_count_int(const char *option, const char *text, long lo, long hi, int *out)
+{
+    long n = 0;
+    vf_status status = cli_count(option, text, lo, hi, &n);
+    if (status == VF_OK)
+        *out = (int)n;
+    return status;
+}
+
+vf_status cli_number(const char *option, const char *text, double lo, double hi, double *out)
+{
+    double value;
+    if (cli_parse_doubles(text, &value, 1) != 1 || !(value >= lo && value <= hi))
+        return vf_fail(VF_EINPUT, "%s wants a number from %g to %g, not '%s'", option, lo, hi,
+                       text);
+    *out = value;
+    return VF_OK;
+}
+
+vf_status cli_size(const char *option, const char *text, int *width, int *height)
+{
+    char tail;
+    int w, h;
+    if (sscanf(text, "%dx%d%c", &w, &h, &tail) != 2 || w <= 0 || h <= 0 || w > 16384 ||
+        h > 16384)
+        return vf_fail(VF_EINPUT, "%s wants WIDTHxHEIGHT, e.g. 1280x720, not '%s'", option, text);
+    *width = w, *height = h;
+    return VF_OK;
+}
+
 vf_status cli_open_trained(const char *root, vf_workspace *ws, vf_field **field)
 {
     vf_status s = vf_workspace_open(root, 0, ws);

@@ -58,6 +58,15 @@ void cli_print_json(json_t *doc);
 int cli_parse_doubles(const char *text, double *out, int max);
 /* Parse a whole-string integer within [lo, hi]; returns 0 on success. */
 int cli_parse_int(const char *text, long lo, long hi, long *out);
+/* An option's whole number within [lo, hi], or VF_EINPUT "OPTION wants a whole number from LO
+ * to HI, not 'TEXT'". */
+vf_status cli_count(const char *option, const char *text, long lo, long hi, long *out);
+/* The same into an int. */
+vf_status cli_count_int(const char *option, const char *text, long lo, long hi, int *out);
+/* An option's number within [lo, hi], or VF_EINPUT "OPTION wants a number from LO to HI". */
+vf_status cli_number(const char *option, const char *text, double lo, double hi, double *out);
+/* An option's "WxH" (1..16384 each), or VF_EINPUT "OPTION wants WIDTHxHEIGHT". */
+vf_status cli_size(const char *option, const char *text, int *width, int *height);
 
 /* Open the workspace at root (never created) and its trained field; on failure nothing stays
  * open. For the commands that only look at a field (render, eval, transfer). */

@@ -33,13 +33,12 @@ static const char usage[] =
     "                         the set counts as correct\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum { OPT_MODELS_DIR = CLI_OPT_FIRST_CUSTOM };
-#define MAX_LABELS 32
 
 typedef struct classify_options {
     const char *model;
     const char *models_dir;
     int top;
-    int labels[MAX_LABELS];
+    int labels[VF_MAX_LABELS];
     int label_count; /* 0: no --label */
     char **images;
     int image_count;
@@ -76,7 +75,7 @@ static vf_status parse_options(int argc, char **argv, classify_options *opt)
             label_text = optarg;
     }
     if (label_text) {
-        vf_status status = vf_parse_label_set(label_text, opt->labels, MAX_LABELS, &opt->label_count);
+        vf_status status = vf_parse_label_set(label_text, opt->labels, VF_MAX_LABELS, &opt->label_count);
         if (status != VF_OK)
             return status;
     }

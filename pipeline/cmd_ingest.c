@@ -78,27 +78,6 @@ enum {
     OPT_SCENE,
 };
 
-/* Parse "WxH". */
-static int parse_size(const char *text, int *width, int *height)
-{
-    char tail;
-    return sscanf(text, "%dx%d%c", width, height, &tail) == 2 && *width > 0 && *height > 0 &&
-                   *width <= 16384 && *height <= 16384
-               ? 0
-               : -1;
-}
-
-static vf_status parse_number(const char *text, const char *option, double lo, double hi,
-                              double *out)
-{
-    double value;
-    if (cli_parse_doubles(text, &value, 1) != 1 || !(value >= lo && value <= hi))
-        return vf_fail(VF_EINPUT, "%s wants a number from %g to %g, not '%s'", option, lo, hi,
-                       text);
-    *out = value;
-    return VF_OK;
-}
-
 /* Apply one of the options of a model's capture. */
 static vf_status apply_model_option(int c, const char *arg, vf_object3d_capture *m)
 {
@@ -115,9 +94,9 @@ static vf_status apply_model_option(int c, const char *arg, vf_object3d_capture 
         long n;
         if (limits[i].option != c)
             continue;
-        if (cli_parse_int(arg, limits[i].lo, limits[i].hi, &n))
-            return vf_fail(VF_EINPUT, "%s wants a whole number from %ld to %ld, not '%s'",
-                           limits[i].name, limits[i].lo, limits[i].hi, arg);
+        vf_status s = cli_count(limits[i].name, arg, limits[i].lo, limits[i].hi, &n);
+        if (s != VF_OK)
+            return s;
         int *field[] = {&m->views, &m->test_views, &m->size, &m->samples};
         if (c == OPT_SEED)
             m->seed = (uint64_t)n;
@@ -131,7 +110,6 @@ static vf_status apply_model_option(int c, const char *arg, vf_object3d_capture 
 static vf_status apply_option(int c, const char *arg, ingest_options *opt)
 {
     vf_ingest_options *cap = &opt->req.capture;
-    long n;
     switch (c) {
     case 't':
         opt->transforms = arg;
@@ -139,35 +117,22 @@ static vf_status apply_option(int c, const char *arg, ingest_options *opt)
     case 'o':
         opt->workspace = arg;
         return VF_OK;
-    case 'n':
-        if (cli_parse_int(arg, 1, 100000, &n))
-            return vf_fail(VF_EINPUT, "--frames wants a whole number from 1 to 100000, not '%s'",
-                           arg);
-        cap->select.max_frames = (int)n;
-        return VF_OK;
-    case OPT_MAX_SIZE:
-        if (cli_parse_int(arg, 16, 16384, &n))
-            return vf_fail(VF_EINPUT, "--max-size wants pixels from 16 to 16384, not '%s'", arg);
-        cap->max_size = (int)n;
-        return VF_OK;
+    case 'n': return cli_count_int("--frames", arg, 1, 100000, &cap->select.max_frames);
+    case OPT_MAX_SIZE: return cli_count_int("--max-size", arg, 16, 16384, &cap->max_size);
     case OPT_BLUR_RATIO:
         /* one knob for both rules (the local one of videos, the global one of photos) */
-        if (parse_number(arg, "--blur-ratio", 0, 0.99, &cap->select.blur_ratio) != VF_OK)
+        if (cli_number("--blur-ratio", arg, 0, 0.99, &cap->select.blur_ratio) != VF_OK)
             return VF_EINPUT;
         cap->photo_blur_ratio = cap->select.blur_ratio;
         return VF_OK;
     case OPT_DUPLICATE_THRESHOLD:
-        return parse_number(arg, "--duplicate-threshold", 0, 255,
-                            &cap->select.duplicate_threshold);
+        return cli_number("--duplicate-threshold", arg, 0, 255, &cap->select.duplicate_threshold);
     case OPT_V4L2:
         opt->device = arg;
         return VF_OK;
     case OPT_SECONDS:
-        return parse_number(arg, "--seconds", 0.1, 3600, &cap->seconds);
-    case OPT_SIZE:
-        if (parse_size(arg, &cap->width, &cap->height))
-            return vf_fail(VF_EINPUT, "--size wants WIDTHxHEIGHT, e.g. 1280x720, not '%s'", arg);
-        return VF_OK;
+        return cli_number("--seconds", arg, 0.1, 3600, &cap->seconds);
+    case OPT_SIZE: return cli_size("--size", arg, &cap->width, &cap->height);
     case OPT_VIEWS:
     case OPT_TEST_VIEWS:
     case OPT_RENDER_SIZE:

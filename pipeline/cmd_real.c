@@ -36,14 +36,6 @@ typedef struct real_options {
     cli_flags flags;
 } real_options;
 
-static vf_status parse_count(const char *name, const char *text, long lo, long hi, long *out)
-{
-    if (cli_parse_int(text, lo, hi, out))
-        return vf_fail(VF_EINPUT, "--%s wants a whole number from %ld to %ld, not '%s'", name, lo,
-                       hi, text);
-    return VF_OK;
-}
-
 static vf_status parse_options(int argc, char **argv, real_options *opt)
 {
     static const struct option longopts[] = {
@@ -68,11 +60,11 @@ static vf_status parse_options(int argc, char **argv, real_options *opt)
             opt->real.classifier = optarg;
         else if (c == OPT_MODELS_DIR)
             opt->real.models_dir = optarg;
-        else if (c == OPT_FLUCT && (s = parse_count("fluctuation-samples", optarg, 1, 1000, &n)) == VF_OK)
+        else if (c == OPT_FLUCT && (s = cli_count("--fluctuation-samples", optarg, 1, 1000, &n)) == VF_OK)
             opt->real.fluctuation_samples = (int)n;
-        else if (c == OPT_NATURAL && (s = parse_count("natural-views", optarg, 1, 100000, &n)) == VF_OK)
+        else if (c == OPT_NATURAL && (s = cli_count("--natural-views", optarg, 1, 100000, &n)) == VF_OK)
             opt->real.natural_views = (int)n;
-        else if (c == OPT_SEED && (s = parse_count("seed", optarg, 0, LONG_MAX, &n)) == VF_OK)
+        else if (c == OPT_SEED && (s = cli_count("--seed", optarg, 0, LONG_MAX, &n)) == VF_OK)
             opt->real.seed = (uint64_t)n;
     }
     if (s != VF_OK)

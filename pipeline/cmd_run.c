@@ -117,16 +117,6 @@ static int stage_is_current(const vf_workspace *ws, const json_t *memory, const 
            !strcmp(stamp, json_string_value(json_object_get(last, "completed")) ?: "");
 }
 
-static vf_status parse_count(const char *option, const char *text, long lo, long hi, int *out)
-{
-    long n;
-    if (cli_parse_int(text, lo, hi, &n))
-        return vf_fail(VF_EINPUT, "%s wants a whole number from %ld to %ld, not '%s'", option, lo,
-                       hi, text);
-    *out = (int)n;
-    return VF_OK;
-}
-
 static vf_status parse_options(int argc, char **argv, run_options *o)
 {
     static const struct option longopts[] = {
@@ -160,7 +150,7 @@ static vf_status parse_options(int argc, char **argv, run_options *o)
         case 'm': o->attack.model = optarg; break;
         case 'l': o->attack.label = optarg; break;
         case 'n':
-            s = parse_count("--frames", optarg, 1, 100000, &o->ingest.capture.select.max_frames);
+            s = cli_count_int("--frames", optarg, 1, 100000, &o->ingest.capture.select.max_frames);
             break;
         case OPT_MINUTES:
             if (cli_parse_doubles(optarg, &o->train.minutes, 1) != 1 ||
@@ -169,12 +159,12 @@ static vf_status parse_options(int argc, char **argv, run_options *o)
                             optarg);
             break;
         case OPT_TRAIN_STEPS:
-            s = parse_count("--train-steps", optarg, 1, 10000000, &o->train.steps);
+            s = cli_count_int("--train-steps", optarg, 1, 10000000, &o->train.steps);
             break;
         case OPT_SAMPLES:
-            s = parse_count("--samples", optarg, 2, 100000, &o->attack.samples);
+            s = cli_count_int("--samples", optarg, 2, 100000, &o->attack.samples);
             break;
-        case OPT_STEPS: s = parse_count("--steps", optarg, 0, 100000, &o->attack.steps); break;
+        case OPT_STEPS: s = cli_count_int("--steps", optarg, 0, 100000, &o->attack.steps); break;
         case OPT_RESTART: o->restart = 1; break;
         }
     }

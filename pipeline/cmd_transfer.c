@@ -1,20 +1,13 @@
-/* vfcapture transfer: do an attack's viewpoints fool other classifiers too?
- *
- * Re-renders the attack's v* and its 100 samples of p*(v) (from WS/attack/attack.json) for
- * each model's input size (same field of view) and measures, per model, the natural accuracy
- * over the training views, the ASR of R(v*) and the ASR over the samples, with the attack's
- * label set. Writes WS/transfer/transfer.json. */
+/* vfcapture transfer: parse the options, resolve the model names, run the transfer stage
+ * (vf/transfer.h), print its table. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
-#include "vf/attack_file.h"
 #include "vf/classifier.h"
-#include "vf/dataset.h"
-#include "vf/log.h"
 #include "vf/resources.h"
-#include "vf/view_loss.h"
+#include "vf/transfer.h"
 
 #define MAX_MODELS 16
 
@@ -83,52 +76,6 @@ static vf_status find_models(const transfer_options *opt, char paths[][VF_PATH_M
     return *count ? VF_OK : vf_fail(VF_EINPUT, "--models names no model");
 }
 
-static double fooled_rate(const vf_view_prediction *p, int n)
-{
-    int fooled = 0;
-    for (int i = 0; i < n; i++)
-        fooled += !p[i].correct;
-    return (double)fooled / n;
-}
-
-/* One model: natural accuracy, ASR of v*, ASR over the samples, as a JSON row. */
-static vf_status measure_model(const char *model, const vf_field *field, const double *c2w,
-                               int views, const vf_attack_file *r, json_t **row)
-{
-    vf_classifier *cls = NULL;
-    vf_view_loss *vl = NULL;
-    vf_view_prediction *pred = malloc((size_t)(views > r->sample_count ? views : r->sample_count) *
-                                      sizeof *pred);
-    vf_view_prediction star;
-    vf_status s = pred ? vf_classifier_open(model, &cls) : vf_fail(VF_EINTERNAL, "out of memory");
-    if (s == VF_OK)
-        s = vf_view_loss_create(field, cls, &vl);
-    if (s == VF_OK)
-        s = vf_view_loss_set_labels(vl, r->labels, r->label_count);
-    double natural = 0, asr = 0;
-    if (s == VF_OK && (s = vf_view_loss_classify_poses(vl, c2w, views, pred)) == VF_OK)
-        natural = 1 - fooled_rate(pred, views);
-    if (s == VF_OK)
-        s = vf_view_loss_classify(vl, r->samples, r->sample_count, pred, NULL);
-    if (s == VF_OK)
-        asr = fooled_rate(pred, r->sample_count);
-    if (s == VF_OK) {
-        double v_star[VF_VIEW_DIM];
-        vf_viewpoint_to_array(&r->v_star, v_star);
-        s = vf_view_loss_classify(vl, v_star, 1, &star, NULL);
-    }
-    if (s == VF_OK)
-        *row = json_pack("{s:s, s:s, s:i, s:f, s:f, s:f, s:o}", "model", model, "engine",
-                         vf_classifier_engine(cls), "input_size",
-                         vf_classifier_input_size(cls), "natural_accuracy", natural, "asr_samples",
-                         asr, "asr_v_star", star.correct ? 0.0 : 1.0, "v_star_prediction",
-                         vf_view_prediction_to_json(&star));
-    vf_view_loss_free(vl);
-    vf_classifier_close(cls);
-    free(pred);
-    return s;
-}
-
 static void print_table(const json_t *rows)
 {
     printf("%-36s %5s %9s %10s %10s  %s\n", "model", "input", "natural", "ASR R(v*)",
@@ -152,64 +99,19 @@ static void print_table(const json_t *rows)
 static vf_status run(const transfer_options *opt)
 {
     static char models[MAX_MODELS][VF_PATH_MAX];
+    char *paths[MAX_MODELS];
     int model_count = 0;
-    vf_workspace ws = {0};
-    vf_field *field = NULL;
-    vf_dataset natural = {0};
-    double *c2w = NULL;
-    vf_attack_file r = {0};
-    json_t *rows = json_array();
-    vf_stage stage;
-    vf_status s = find_models(opt, models, &model_count);
-    if (s == VF_OK)
-        s = vf_class_names_load();
-    if (s == VF_OK)
-        s = cli_open_trained(opt->workspace, &ws, &field);
-    if (s == VF_OK)
-        s = vf_attack_file_load_workspace(&ws, &r);
-    if (s == VF_OK && r.sample_count < 1)
-        s = vf_fail(VF_EINPUT, "%s/attack/attack.json has no samples: run the attack again",
-                    ws.root);
-    if (s == VF_OK && (s = vf_dataset_load_training(&ws, &natural, NULL)) == VF_OK &&
-        !(c2w = vf_dataset_poses(&natural)))
-        s = vf_fail(VF_EINTERNAL, "out of memory");
-    vf_progress progress;
-    vf_progress_begin(&progress, "transfer", (size_t)model_count, "models");
-    for (int m = 0; m < model_count && s == VF_OK; m++) {
-        json_t *row = NULL;
-        s = measure_model(models[m], field, c2w, natural.count, &r, &row);
-        if (s == VF_OK)
-            json_array_append_new(rows, row);
-        vf_progress_update(&progress, (size_t)m + 1, NULL);
-    }
-    if (s == VF_OK)
-        vf_progress_end(&progress);
-    char path[VF_PATH_MAX];
     json_t *doc = NULL;
-    if (s == VF_OK && (s = vf_stage_begin(&ws, "transfer", &stage)) == VF_OK) {
-        doc = json_pack("{s:s, s:O, s:i, s:O}", "attack_model", r.model, "label", r.label,
-                        "samples", r.sample_count, "models", rows);
-        s = vf_path_join(path, sizeof path, stage.dir, "transfer.json");
-        if (s == VF_OK)
-            s = vf_json_save(path, doc);
-        if (s == VF_OK)
-            s = vf_stage_commit(&stage, json_pack("{s:s}", "models", opt->models), NULL);
-        else
-            vf_stage_abort(&stage);
-    }
-    if (s == VF_OK) {
-        if (opt->flags.json)
-            cli_print_json(json_incref(doc));
-        else
-            print_table(rows);
-    }
+    vf_status s = find_models(opt, models, &model_count);
+    for (int m = 0; m < model_count; m++)
+        paths[m] = models[m];
+    if (s == VF_OK)
+        s = vf_transfer_run(opt->workspace, paths, model_count, &doc);
+    if (s == VF_OK && opt->flags.json)
+        cli_print_json(json_incref(doc));
+    else if (s == VF_OK)
+        print_table(json_object_get(doc, "models"));
     json_decref(doc);
-    json_decref(rows);
-    vf_attack_file_free(&r);
-    vf_dataset_free(&natural);
-    free(c2w);
-    vf_field_free(field);
-    vf_workspace_close(&ws);
     return s;
 }
 

@@ -38,6 +38,15 @@ mkdir -p "$tmp/charuco_views" && cp "$tmp/charuco.png" "$tmp/charuco_views/a.png
 expect 1 "too few ChArUco boards" -- "$tool" calib intrinsics "$tmp/charuco_views" --board 7x5 \
   --square 40 --charuco 30 --dict 4x4_50 -o "$tmp/cam.json" --quiet
 one_line_naming "too few ChArUco boards" "found in only 1 of 1 frames"
+# A video: at most --frames frames spread over it (a still board, 30 frames: 4 searched, or 30).
+ffmpeg -loglevel error -y -loop 1 -i "$tmp/board.png" -frames:v 30 -pix_fmt yuv420p \
+  "$tmp/board.mp4" && ok || bad "ffmpeg made the board video"
+expect 1 "video: --frames searched" -- "$tool" calib intrinsics "$tmp/board.mp4" --board 9x6 \
+  --square 25 --frames 4 --quiet
+one_line_naming "video: --frames searched" "found in only [0-9]* of 4 frames"
+expect 1 "video shorter than --frames" -- "$tool" calib intrinsics "$tmp/board.mp4" --board 9x6 \
+  --square 25 --frames 100 --min-views 40 --max-views 40 --quiet
+one_line_naming "video shorter than --frames" "found in only [0-9]* of 30 frames"
 expect 1 "marker larger than square" -- "$tool" calib intrinsics "$tmp/charuco_views" --board 7x5 \
   --square 40 --charuco 45
 one_line_naming "marker larger than square" "--charuco"

@@ -332,17 +332,16 @@ static void test_scale(void)
           "unknown frame named: %s", vf_error_message());
     vf_workspace_close(&ws);
 
-    /* the command stores it where other commands find it */
-    const char *tool = getenv("VF_TOOL");
-    if (tool) {
-        CHECK(vf_test_system("'%s' calib scale '%s' --marker %d --size 100 --quiet", tool, root,
-                             MARKER_ID) == 0,
-              "calib scale command");
-        CHECK(vf_workspace_open(root, 0, &ws) == VF_OK, "%s", vf_error_message());
-        CHECK(vf_workspace_metres_per_unit(&ws, &s), "scale stored");
-        CHECK_NEAR(s, 0.2, 0.002);
-        vf_workspace_close(&ws);
-    }
+    /* the stage stores it where other commands find it */
+    vf_scale_request req = {.marker = MARKER_ID, .size_m = 0.1};
+    json_t *result = NULL;
+    CHECK(vf_calib_scale_run(root, &req, &result) == VF_OK && result, "calib scale stage: %s",
+          vf_error_message());
+    json_decref(result);
+    CHECK(vf_workspace_open(root, 0, &ws) == VF_OK, "%s", vf_error_message());
+    CHECK(vf_workspace_metres_per_unit(&ws, &s), "scale stored");
+    CHECK_NEAR(s, 0.2, 0.002);
+    vf_workspace_close(&ws);
     vf_dataset_free(&ds);
 }
 

@@ -10,7 +10,8 @@
  *     frames; `score --summary` tabulates it;
  *   - `export`: targets.json maps v* back to COLMAP's frame exactly (the pose COLMAP gave
  *     that frame), with CSV and shot card;
- *   - `reshoot --video` on the same video saves exactly the frames on target.
+ *   - `reshoot --video` on the same video saves exactly the frames on target, and keeps them
+ *     when the input breaks after them.
  * Give a workspace with poses as argv[1] to skip the COLMAP run. */
 #include <jansson.h>
 #include <stdlib.h>
@@ -490,6 +491,34 @@ static void check_reshoot(const char *ws, const char *video, int kept)
     json_decref(doc);
 }
 
+/* A capture that fails part-way (here a broken image after the video) keeps the frames already
+ * on target: exit 1 with one line saying so, and the stage is committed with stopped_early. */
+static void check_reshoot_stops(const char *ws, const char *video, int kept)
+{
+    char dir[VF_PATH_MAX], path[2 * VF_PATH_MAX], err[VF_PATH_MAX];
+    snprintf(dir, sizeof dir, "%s/interrupted", vf_test_tmpdir());
+    snprintf(err, sizeof err, "%s/reshoot_stops.err", vf_test_tmpdir());
+    int rc = vf_test_system("mkdir -p '%s' && ln -sf '%s' '%s/a.mp4' && echo broken >'%s/zz.png'",
+                            dir, video, dir, dir);
+    CHECK(rc == 0, "made the failing input");
+    rc = vf_test_system("'%s' reshoot '%s' --target 0 --video '%s' --tolerance %g --smoothing 1 "
+                        ">/dev/null 2>'%s'",
+                        tool(), ws, dir, 100 * TOLERANCE, err);
+    CHECK(rc == 1, "a capture that fails part-way exits 1 (%d)", rc);
+    char *text = NULL;
+    CHECK(vf_read_file(err, &text, NULL) == VF_OK && text && strstr(text, "zz.png") &&
+              strstr(text, "are kept in"),
+          "one line naming the bad frame and the frames kept: %s", text ? text : "?");
+    free(text);
+    snprintf(path, sizeof path, "%s/reshoot_t00/poses.json", ws);
+    json_t *doc = load_json(path);
+    CHECK(json_is_string(json_object_get(doc, "stopped_early")), "poses.json says it stopped");
+    CHECK((int)json_array_size(json_object_get(doc, "frames")) == kept,
+          "the %d frames on target are kept (%zu)", kept,
+          json_array_size(json_object_get(doc, "frames")));
+    json_decref(doc);
+}
+
 int main(int argc, char **argv)
 {
     char names[64][64], ws[VF_PATH_MAX], path[2 * VF_PATH_MAX], video[VF_PATH_MAX];
@@ -532,6 +561,7 @@ int main(int argc, char **argv)
     int kept = check_score(ws, video, known, n, &v_star);
     check_export(ws);
     check_reshoot(ws, video, kept);
+    check_reshoot_stops(ws, video, kept);
 
     free(aligned);
     free(known);

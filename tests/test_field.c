@@ -343,23 +343,27 @@ static void test_model_files(void)
         vf_field_free(loaded);
     }
     /* a flipped byte in the grid values */
-    vf_test_system("cp '%s' '%s'", path, copy);
+    char *bytes = NULL;
+    size_t size = 0;
+    CHECK(vf_read_file(path, &bytes, &size) == VF_OK && size > 3000, "read %s", path);
+    vf_write_file_atomic(copy, bytes, size);
     const unsigned char junk = 0x5a;
     patch_file(copy, 2000, &junk, 1);
     loaded = NULL;
     CHECK(vf_field_load(copy, &loaded) == VF_EINPUT && !loaded, "corrupt file rejected");
     CHECK(strstr(vf_error_message(), "corrupt") != NULL, "message: %s", vf_error_message());
     /* another format version */
-    vf_test_system("cp '%s' '%s'", path, copy);
+    vf_write_file_atomic(copy, bytes, size);
     const uint32_t version = 99;
     patch_file(copy, 8, &version, sizeof version);
     CHECK(vf_field_load(copy, &loaded) == VF_EINPUT && !loaded, "other version rejected");
     CHECK(strstr(vf_error_message(), "version 99") != NULL, "message: %s", vf_error_message());
     /* truncated, and not a model at all */
-    vf_test_system("head -c 3000 '%s' > '%s'", path, copy);
+    vf_write_file_atomic(copy, bytes, 3000);
     CHECK(vf_field_load(copy, &loaded) == VF_EINPUT && !loaded, "truncated file rejected");
-    vf_test_system("echo hello > '%s'", copy);
+    vf_write_file_atomic(copy, "hello\n", 6);
     CHECK(vf_field_load(copy, &loaded) == VF_EINPUT && !loaded, "non-model rejected");
+    free(bytes);
     CHECK(vf_field_load("/nonexistent/model.vff", &loaded) == VF_EINPUT, "missing file");
     vf_field_free(f);
 }

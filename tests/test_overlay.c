@@ -11,7 +11,7 @@ static const unsigned char *pixel(const vf_rgb8 *img, int x, int y)
     return img->data + 3 * ((size_t)y * img->width + x);
 }
 
-int main(void)
+static void test_overlay_draw(void)
 {
     vf_rgb8 frame = {0}, out = {0};
     CHECK(vf_rgb8_resize_buffer(&frame, 320, 240) == VF_OK, "alloc");
@@ -44,5 +44,11 @@ int main(void)
 
     vf_rgb8_free(&frame);
     vf_rgb8_free(&out);
+}
+
+int main(int argc, char **argv)
+{
+    check_args(argc, argv);
+    CHECK_CASE(test_overlay_draw);
     return check_finish();
 }

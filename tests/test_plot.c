@@ -58,10 +58,20 @@ static void test_sheet(const char *dir)
     CHECK(vf_contact_sheet(path, tiles, captions, mark, 0, 2) == VF_EINPUT, "no images refused");
 }
 
-int main(void)
+static void test_line_plot(void)
 {
-    const char *dir = vf_test_tmpdir();
-    test_lines(dir);
-    test_sheet(dir);
+    test_lines(vf_test_tmpdir());
+}
+
+static void test_contact_sheet(void)
+{
+    test_sheet(vf_test_tmpdir());
+}
+
+int main(int argc, char **argv)
+{
+    check_args(argc, argv);
+    CHECK_CASE(test_line_plot);
+    CHECK_CASE(test_contact_sheet);
     return check_finish();
 }

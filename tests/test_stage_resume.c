@@ -6,7 +6,7 @@
 #include "vf/fsutil.h"
 #include "vf/workspace.h"
 
-int main(void)
+static void test_resume_rules(void)
 {
     char root[VF_PATH_MAX], file[VF_PATH_MAX];
     snprintf(root, sizeof root, "%s/ws", vf_test_tmpdir());
@@ -36,5 +36,11 @@ int main(void)
     CHECK(vf_stage_commit(&s, NULL, NULL) == VF_OK, "%s", vf_error_message());
     CHECK(vf_workspace_has_stage(&ws, "attack"), "the resumed stage is recorded on commit");
     vf_workspace_close(&ws);
+}
+
+int main(int argc, char **argv)
+{
+    check_args(argc, argv);
+    CHECK_CASE(test_resume_rules);
     return check_finish();
 }

@@ -2,6 +2,9 @@
  * guidance advice, pose smoothing and attack.json reading. */
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "vf/attack_file.h"
@@ -169,6 +172,31 @@ static void test_attack_file(void)
           "a short v_star is refused: %s", vf_error_message());
 }
 
+/* Out of memory while spreading is an error, never a list of repeated picks. A child process
+ * caps its address space so that the buffer for 2^31 - 1 viewpoints cannot be had (skipped
+ * under AddressSanitizer, whose allocator aborts instead of failing). */
+static void test_spread_out_of_memory(void)
+{
+#if defined(__SANITIZE_ADDRESS__)
+    printf("skipped under AddressSanitizer\n");
+#else
+    pid_t pid = fork();
+    if (pid == 0) {
+        struct rlimit cap = {(rlim_t)2 << 30, (rlim_t)2 << 30};
+        setrlimit(RLIMIT_AS, &cap);
+        const double views[6] = {0}, range[6] = {360, 60, 140, 1, 2, 1};
+        int picked[2] = {-1, -1};
+        /* views is never read when the buffer cannot be had */
+        vf_status s = vf_targets_spread(views, 0x7fffffff, range, 2, picked);
+        _exit(s == VF_EINTERNAL && strstr(vf_error_message(), "out of memory") ? 0 : 1);
+    }
+    int status = 0;
+    CHECK(pid > 0 && waitpid(pid, &status, 0) == pid && WIFEXITED(status) &&
+              WEXITSTATUS(status) == 0,
+          "spreading without memory fails cleanly (child status %d)", status);
+#endif
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
@@ -176,6 +204,7 @@ int main(int argc, char **argv)
     CHECK_CASE(test_describe);
     CHECK_CASE(test_advice);
     CHECK_CASE(test_spread);
+    CHECK_CASE(test_spread_out_of_memory);
     CHECK_CASE(test_smoother);
     CHECK_CASE(test_attack_file);
     return check_finish();

@@ -1,6 +1,7 @@
 /* V4L2 capture against the in-process fake camera (tests/v4l2_fake.h): format negotiation,
  * streaming order and buffer re-queueing, YUYV and MJPEG conversion against the source
- * images, errors for missing and unsuitable devices, and a whole webcam ingest. */
+ * images, errors for missing and unsuitable devices, a whole webcam ingest, and the frame source
+ * (vf/frames.h) and the calibration's board search reading the fake. */
 #include "v4l2_fake.h"
 
 #include <math.h>
@@ -8,6 +9,8 @@
 #include <string.h>
 
 #include "check.h"
+#include "vf/calib.h"
+#include "vf/frames.h"
 #include "vf/fsutil.h"
 #include "vf/ingest.h"
 #include "vf/log.h"
@@ -294,6 +297,77 @@ static void test_camera_ingest(void)
     }
 }
 
+/* The frame source on a webcam: the fake's frames in order, named DEVICE#N, device closed. */
+static void test_frames_source(void)
+{
+    fake_camera cam;
+    make_camera(&cam, both, 2);
+    vf_v4l2_ops ops = fake_ops(&cam);
+    vf_frames in;
+    vf_status status = vf_frames_open_v4l2(DEVICE, &ops, NULL, &in);
+    CHECK(status == VF_OK, "%s", vf_error_message());
+    if (status != VF_OK)
+        return;
+    CHECK(cam.streaming, "streaming once open");
+    vf_rgb8 frame = {0, 0, NULL};
+    vf_frame_info info;
+    for (int i = 0; i < 3; i++) {
+        int got = 0;
+        char name[64];
+        status = vf_frames_next(&in, &frame, &info, &got);
+        CHECK(status == VF_OK && got, "frame %d: %s", i, vf_error_message());
+        if (status != VF_OK || !got)
+            break;
+        snprintf(name, sizeof name, "%s#%d", DEVICE, i);
+        CHECK(!strcmp(info.name, name) && info.index == i, "frame %d named %s", i, info.name);
+        double diff = vf_rgb8_mean_abs_diff(&frame, &sources[i]);
+        CHECK(diff >= 0 && diff < 3, "frame %d is the fake's (difference %.2f)", i, diff);
+    }
+    vf_frames_close(&in);
+    vf_rgb8_free(&frame);
+    CHECK(!cam.streaming && cam.closes == 1, "device stopped and closed");
+    fake_camera none;
+    make_camera(&none, both, 2);
+    none.path = "/dev/video-other";
+    ops = fake_ops(&none);
+    expect_error(vf_frames_open_v4l2(DEVICE, &ops, NULL, &in), "does not exist");
+}
+
+/* calib intrinsics --v4l2 on the fake filming a flat board: every frame searched is a view,
+ * named after the driver's frame number. */
+static void test_calib_camera(void)
+{
+    vf_calib_board board = {9, 6, 0.03, 0, 0};
+    vf_rgb8 image = {0, 0, NULL};
+    unsigned char *jpeg = NULL;
+    size_t size = 0;
+    vf_status status = vf_calib_board_image(&board, 16, &image);
+    if (status == VF_OK)
+        status = vf_rgb8_encode_jpeg(&image, 95, &jpeg, &size);
+    CHECK(status == VF_OK, "%s", vf_error_message());
+    fake_camera cam;
+    const uint32_t mjpeg_only[] = {V4L2_PIX_FMT_MJPEG};
+    fake_init(&cam, DEVICE, mjpeg_only, 1, image.width, image.height);
+    cam.frame_count = 1;
+    cam.mjpeg = &jpeg;
+    cam.mjpeg_size = &size;
+    vf_v4l2_ops ops = fake_ops(&cam);
+    vf_calib_views views = {0};
+    if (status == VF_OK)
+        status = vf_calib_collect_camera(DEVICE, &ops, &board, 0.2, &views);
+    CHECK(status == VF_OK, "%s", vf_error_message());
+    CHECK(views.frames_seen > 0 && views.count == views.frames_seen, "board in %d of %d frames",
+          views.count, views.frames_seen);
+    CHECK(views.count == 0 || !strcmp(views.views[0].name, "frame 0"), "first view named %s",
+          views.count ? views.views[0].name : "");
+    CHECK(views.width == image.width && views.height == image.height, "frame size %dx%d",
+          views.width, views.height);
+    CHECK(cam.opens == 1 && cam.closes == 1, "device opened and closed once");
+    vf_calib_views_free(&views);
+    vf_rgb8_free(&image);
+    free(jpeg);
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
@@ -308,6 +382,8 @@ int main(int argc, char **argv)
     CHECK_CASE(test_yuyv_colours);
     CHECK_CASE(test_errors);
     CHECK_CASE(test_camera_ingest);
+    CHECK_CASE(test_frames_source);
+    CHECK_CASE(test_calib_camera);
     for (int i = 0; i < FRAMES; i++) {
         vf_rgb8_free(&sources[i]);
         free(yuyv[i]);

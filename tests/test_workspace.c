@@ -4,6 +4,8 @@
 #include <string.h>
 
 #include "check.h"
+#include "vf/ingest.h"
+#include "vf/rgb8.h"
 #include "vf/workspace.h"
 
 static void write_text(const char *dir, const char *name, const char *text)
@@ -49,11 +51,51 @@ static void test_error_chaining(void)
           "chained message: %s", vf_error_message());
 }
 
-int main(int argc, char **argv)
+/* An ingest whose commit fails (WS/ingest is a file, so the staged folder cannot move into
+ * place) reports the failure with no summary: the old stage handed out a copy and leaked it. */
+static void test_ingest_failed_commit(void)
 {
-    check_args(argc, argv);
-    CHECK_CASE(test_json_round_trip);
-    CHECK_CASE(test_error_chaining);
+    char root[VF_PATH_MAX], blocker[VF_PATH_MAX], photos[VF_PATH_MAX], path[VF_PATH_MAX];
+    vf_path_join(root, sizeof root, vf_test_tmpdir(), "ws_blocked");
+    vf_path_join(photos, sizeof photos, vf_test_tmpdir(), "posed");
+    vf_workspace ws;
+    CHECK(vf_workspace_open(root, 1, &ws) == VF_OK, "create");
+    vf_workspace_close(&ws);
+    vf_path_join(blocker, sizeof blocker, root, "ingest");
+    write_text(root, "ingest", "a file where the stage folder goes");
+    CHECK(vf_mkdirs(photos) == VF_OK, "photos folder");
+    vf_rgb8 img = {0};
+    CHECK(vf_rgb8_resize_buffer(&img, 32, 24) == VF_OK, "image");
+    for (int i = 0; img.data && i < 32 * 24 * 3; i++)
+        img.data[i] = (unsigned char)(i * 7);
+    for (int i = 0; i < 2; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "r_%d.png", i);
+        vf_path_join(path, sizeof path, photos, name);
+        CHECK(vf_rgb8_save(path, &img) == VF_OK, "save %s", name);
+    }
+    vf_rgb8_free(&img);
+    write_text(photos, "transforms.json",
+               "{\"camera_angle_x\": 0.69, \"frames\": ["
+               "{\"file_path\": \"r_0\", \"transform_matrix\": [[1,0,0,0],[0,1,0,0],[0,0,1,4],[0,0,0,1]]},"
+               "{\"file_path\": \"r_1\", \"transform_matrix\": [[0,-1,0,0],[1,0,0,0],[0,0,1,4],[0,0,0,1]]}]}");
+    vf_ingest_request r;
+    vf_ingest_request_defaults(&r);
+    r.kind = VF_INGEST_TRANSFORMS;
+    vf_path_join(path, sizeof path, photos, "transforms.json");
+    r.input = path;
+    json_t *summary = (json_t *)1;
+    CHECK(vf_ingest_run(root, &r, &summary) != VF_OK, "the commit fails");
+    CHECK(summary == NULL, "no summary of a stage that did not land");
+    CHECK(file_says(blocker, "a file where the stage folder goes"), "the blocker is untouched");
+    if (summary && summary != (json_t *)1)
+        json_decref(summary);
+}
+
+/* Stage outputs swap in atomically; a failed or aborted run keeps the earlier output; foreign
+ * folders and corrupt manifests are refused. */
+static void test_stage_swap(void)
+{
     char root[VF_PATH_MAX], path[VF_PATH_MAX];
     vf_path_join(root, sizeof root, vf_test_tmpdir(), "ws");
     vf_workspace ws;
@@ -131,5 +173,14 @@ int main(int argc, char **argv)
     vf_write_file_atomic(path, "{broken", 7);
     CHECK(vf_workspace_open(root, 1, &ws) == VF_EINPUT, "corrupt manifest refused");
     CHECK(file_says(path, "{broken"), "corrupt manifest left for the user to inspect");
+}
+
+int main(int argc, char **argv)
+{
+    check_args(argc, argv);
+    CHECK_CASE(test_json_round_trip);
+    CHECK_CASE(test_error_chaining);
+    CHECK_CASE(test_stage_swap);
+    CHECK_CASE(test_ingest_failed_commit);
     return check_finish();
 }

@@ -203,6 +203,20 @@ vf_status vf_scale_from_picks(const vf_workspace *ws, const vf_pick *p1, int n1,
                               const vf_pick *p2, int n2, double distance_m,
                               double *metres_per_unit, json_t **details);
 
+/* The calib stage's scale: a marker (id >= 0, size_m) or two points (p1 and p2 non-NULL:
+ * the picks' text as vf_parse_picks reads it, distance_m apart). */
+typedef struct vf_scale_request {
+    int marker;            /* ArUco id, or -1 */
+    double size_m;         /* the marker's black square, metres */
+    const char *p1, *p2;   /* or two picked points... */
+    double distance_m;     /* ...this far apart */
+} vf_scale_request;
+
+/* Measure the scale and keep it as the workspace's calib stage (WS/calib/scale.json:
+ * metres_per_unit, units_per_metre, method, details); *result (a new reference) is that
+ * document. A failed measurement leaves the workspace as it was. */
+vf_status vf_calib_scale_run(const char *ws_root, const vf_scale_request *r, json_t **result);
+
 /* Whether the workspace has a metric scale (WS/calib/scale.json); *metres_per_unit gets it. */
 int vf_workspace_metres_per_unit(const vf_workspace *ws, double *metres_per_unit);
 

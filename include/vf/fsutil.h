@@ -36,9 +36,21 @@ vf_status vf_read_file(const char *path, char **data, size_t *size);
 vf_status vf_write_file_atomic(const char *path, const void *data, size_t size);
 vf_status vf_copy_file(const char *src, const char *dst);
 
-/* The JPEG and PNG file names (.jpg, .jpeg, .png, any case; no hidden files) in a folder,
- * sorted by name, in *names (count of them, possibly 0). Free with vf_free_names. */
+/* Whether path's extension (after its last '.', any case) is one of exts (NULL-terminated,
+ * without dots: {"jpg", "png", NULL}). */
+int vf_path_has_extension(const char *path, const char *const *exts);
+/* Whether a file name looks like a JPEG or PNG image (.jpg, .jpeg, .png, any case). */
+int vf_is_image_name(const char *path);
+
+/* The names (not paths) in a folder that keep() accepts, hidden files never, sorted by name,
+ * in *names (count of them, possibly 0). The caller frees them with vf_free_names. VF_EINPUT
+ * naming the folder when it cannot be opened. The one folder scan: vf_list_images and the
+ * frame source (vf/frames.h) list through it. */
+vf_status vf_list_folder(const char *folder, int (*keep)(const char *name), char ***names,
+                         int *count);
+/* vf_list_folder keeping the JPEG and PNG images (vf_is_image_name). */
 vf_status vf_list_images(const char *folder, char ***names, int *count);
+/* Free a list from vf_list_folder / vf_list_images; NULL is fine. */
 void vf_free_names(char **names, int count);
 
 #ifdef __cplusplus

@@ -46,6 +46,15 @@ vf_status vf_image_to_rgb(const vf_image *src, const float background[3], vf_ima
  * the pixels. */
 vf_status vf_image_info(const char *path, int *width, int *height, int *channels);
 
+/* The EXIF orientation (1..8) a file's pixels must be turned by to show it upright: a JPEG's
+ * (recognised by its content, not its name), 1 for every other format. The one rule of the
+ * project: vf_image_load and vf_rgb8_load both apply it. VF_EINPUT when it cannot be read. */
+vf_status vf_image_orientation(const char *path, int *orientation);
+
+/* Where the stored pixel shown at (u, v) lies, (*x, *y), for a width x height stored image
+ * under EXIF orientation `orientation`. */
+void vf_orientation_source(int orientation, int width, int height, int u, int v, int *x, int *y);
+
 /* src as EXIF orientation `orientation` (1..8) says to show it: 1 as stored, 2 mirrored, 3
  * turned 180 degrees, 4 flipped, 5 transposed, 6 turned 90 degrees clockwise, 7 transversed,
  * 8 turned 90 degrees counter-clockwise (5..8 swap width and height). Other values: a copy. */

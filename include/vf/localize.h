@@ -17,7 +17,7 @@
  * Intrinsics: the camera COLMAP found for the capture, or a calibration (vf_camera); frames of
  * another size but the same aspect ratio use it scaled.
  *
- * Also here: smoothing a stream of poses (for live guidance), and reading normalization.json.
+ * Also here: smoothing a stream of poses (for live guidance).
  *
  * Threads: a vf_localizer is used by one thread at a time. Memory: vf_localizer_open
  * allocates the localizer, vf_localizer_close frees it; results are plain values. */
@@ -30,6 +30,7 @@
 #include "vf/error.h"
 #include "vf/pose.h"
 #include "vf/rgb8.h"
+#include "vf/sfm_export.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -84,13 +85,6 @@ vf_status vf_localize_frame(vf_localizer *loc, const vf_rgb8 *frame, vf_localize
  * "seconds"} and either "reason" or "viewpoint", "c2w_object", "c2w_colmap" (a new
  * reference). */
 json_t *vf_localize_result_json(const vf_localize_result *r);
-
-/* ---- normalization.json ---- */
-
-/* Read WS/poses/normalization.json: the similarity from COLMAP's frame to the object frame
- * and back. */
-vf_status vf_normalization_load(const char *path, vf_similarity *object_from_colmap,
-                                vf_similarity *colmap_from_object);
 
 /* ---- smoothing a stream of poses ---- */
 

@@ -25,9 +25,11 @@ extern "C" {
 typedef struct vf_args {
     char **items;
     int count, capacity;
+    int failed; /* an argument was lost to out-of-memory: the command line is refused */
 } vf_args;
 
-/* Append one argument (copied). Out-of-memory is remembered and reported by vf_process_run. */
+/* Append one argument (copied). Out-of-memory is remembered and reported by vf_process_run and
+ * vf_process_start. An empty vf_args ({0}) runs the program without arguments. */
 void vf_args_add(vf_args *args, const char *item);
 /* Append "--name" and its formatted value,
  * e.g. vf_args_opt(a, "--Mapper.ba_refine_focal_length", "%d", 0). */
@@ -50,8 +52,8 @@ typedef void (*vf_process_line_fn)(const char *line, void *ctx);
 /* Run `program args...` (args->items[0] is argv[1]) and wait for it. Its output goes to log
  * (may be NULL) and, line by line, to on_line (may be NULL). *exit_code gets the exit status,
  * or -1 when it was killed by a signal (then *signal_out, when not NULL, gets the signal).
- * Fails (VF_EINTERNAL) only when the program cannot be started; a non-zero exit is for the
- * caller to judge. */
+ * Fails (VF_EINTERNAL) when the program cannot be started or its end cannot be learned (waitpid
+ * fails, e.g. with SIGCHLD ignored); a non-zero exit is for the caller to judge. */
 vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
                          vf_process_line_fn on_line, void *ctx, int *exit_code, int *signal_out);
 
@@ -64,7 +66,7 @@ vf_status vf_process_start(const char *program, const vf_args *args, int output_
                            int *pid);
 
 /* Wait up to timeout_s seconds for a started child to exit, then kill it (SIGKILL) and reap it.
- * Returns its exit status, or -1 when it was killed by a signal. */
+ * Returns its exit status, or -1 when it was killed by a signal or its status cannot be read. */
 int vf_process_finish(int pid, double timeout_s);
 
 #ifdef __cplusplus

@@ -3,7 +3,8 @@
  * A vf_rgb8 is row-major, tightly packed RGB: pixel (x, y) channel c is
  * data[(y * width + x) * 3 + c]. Capture code keeps frames in this form (a 1080p frame is 6 MB
  * here, 24 MB as a float vf_image); vf/image.h is for the float work that comes later.
- * Decoding, encoding and resizing go through OpenCV (src/opencv/rgb8_cv.cpp).
+ * Decoding, encoding and resizing go through OpenCV (src/image/rgb8_cv.cpp); a photo is turned
+ * upright by the same rule as vf/image.h's reader (vf_image_orientation).
  *
  * Memory: a function that fills a vf_rgb8 allocates its pixels; the caller releases them with
  * vf_rgb8_free(). Those marked "reuses" take an output that is either zeroed or a frame from an
@@ -46,7 +47,8 @@ vf_status vf_rgb8_encode_jpeg(const vf_rgb8 *img, int quality, unsigned char **b
                               size_t *size);
 
 /* Read a photo file (JPEG, PNG, and whatever else OpenCV reads) as RGB: grey is expanded,
- * 16-bit scaled to 8, alpha composited onto white, and a JPEG's EXIF orientation applied.
+ * 16-bit scaled to 8, alpha composited onto white, and a JPEG's EXIF orientation applied
+ * (vf_image_orientation: a JPEG by its content, whatever its name).
  * Reuses out. VF_EINPUT "cannot read PATH: ..." when it is missing or not an image. */
 vf_status vf_rgb8_load(const char *path, vf_rgb8 *out);
 

@@ -34,6 +34,15 @@ vf_status vf_sfm_save_points(const char *path, const vf_colmap_model *model,
  * and the mean camera distance before (COLMAP units) and after (4). */
 vf_status vf_sfm_save_normalization(const char *path, const vf_normalization *norm);
 
+/* The file's name in WS/poses. */
+#define VF_NORMALIZATION_FILE "normalization.json"
+
+/* Read normalization.json: the similarity from COLMAP's frame to the object frame and back
+ * (either output may be NULL). VF_EINPUT naming the file when it is not valid JSON or its
+ * similarity is not one (scale 1e-9..1e9, an orthonormal rotation with det +1). */
+vf_status vf_normalization_load(const char *path, vf_similarity *object_from_colmap,
+                                vf_similarity *colmap_from_object);
+
 #ifdef __cplusplus
 }
 #endif

@@ -38,6 +38,10 @@ typedef struct vf_v4l2_ops {
     int (*poll)(void *ctx, struct pollfd *fds, nfds_t count, int timeout_ms);
 } vf_v4l2_ops;
 
+/* How long a read waits for a webcam that sends nothing before failing: it has stopped. Every
+ * caller of vf_v4l2_read uses this one value. */
+#define VF_CAMERA_TIMEOUT_MS 5000
+
 /* The real system calls. */
 const vf_v4l2_ops *vf_v4l2_system_ops(void);
 

@@ -15,6 +15,7 @@
 
 #include "vf/error.h"
 #include "vf/fsutil.h"
+#include "vf/json.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -52,6 +53,11 @@ vf_status vf_workspace_path(const vf_workspace *ws, const char *stage, const cha
  * what to run first when there is neither. */
 vf_status vf_workspace_training_views(const vf_workspace *ws, char *path, size_t size,
                                       int *real_capture);
+/* The transforms file of the posed frames as stored (with their lens, not undistorted): a
+ * capture's WS/poses/transforms.json or an imported set's WS/ingest/transforms.json. For
+ * pixels picked in the images the user sees (calib scale). VF_EINPUT saying what to run first
+ * when there is neither. */
+vf_status vf_workspace_posed_frames(const vf_workspace *ws, char *path, size_t size);
 
 vf_status vf_stage_begin(vf_workspace *ws, const char *stage, vf_stage *s);
 /* Like vf_stage_begin, but keep what an interrupted run left in the staging folder (a stage
@@ -62,17 +68,6 @@ vf_status vf_stage_resume(vf_workspace *ws, const char *stage, vf_stage *s);
  * resume) and the stage's previous output and manifest record stay as they were. */
 vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary);
 void vf_stage_abort(vf_stage *s);
-
-/* Save a JSON document atomically. */
-vf_status vf_json_save(const char *path, const json_t *doc);
-/* Load a JSON document; errors name the file and the line. */
-vf_status vf_json_load(const char *path, json_t **out);
-/* n numbers as a JSON array (a new reference). */
-json_t *vf_json_doubles(const double *x, int n);
-/* A 4x4 row-major matrix as four rows of four numbers (a new reference). */
-json_t *vf_json_mat4(const double m[16]);
-/* An array of exactly n finite numbers into out: 1, else 0 (out partly written). */
-int vf_json_read_doubles(const json_t *array, double *out, int n);
 
 #ifdef __cplusplus
 }

@@ -6,10 +6,10 @@
 #include <stdlib.h>
 
 #include "ingest_internal.h"
+#include "vf/frames.h"
 #include "vf/log.h"
 
 #define CAPTURE_DIR ".capture"
-#define FRAME_TIMEOUT_MS 5000 /* a camera that sends nothing for this long has stopped */
 
 typedef struct capture_stats {
     double seconds;    /* capture time */
@@ -18,24 +18,26 @@ typedef struct capture_stats {
 } capture_stats;
 
 /* The capture loop: read, score, write into capture_dir, until time or frame limit. */
-static vf_status capture(vf_v4l2 *cam, const vf_ingest_options *o, const char *capture_dir,
+static vf_status capture(vf_frames *in, const vf_ingest_options *o, const char *capture_dir,
                          score_list *scores, capture_stats *stats)
 {
-    const vf_v4l2_info *info = vf_v4l2_get_info(cam);
+    const vf_v4l2_info *info = vf_v4l2_get_info(in->camera);
     double fps = info->fps > 0 ? info->fps : 30;
     size_t expected = o->frame_limit > 0 ? (size_t)o->frame_limit : (size_t)(o->seconds * fps);
     vf_rgb8 frame = {0, 0, NULL};
+    vf_frame_info frame_info;
     vf_live_counter live = {0};
     vf_progress progress;
     vf_status status = VF_OK;
-    uint32_t sequence = 0, previous = 0;
+    uint32_t previous = 0;
     double start = vf_now();
     vf_progress_begin(&progress, "capturing", expected, "frames");
     while (status == VF_OK && vf_now() - start < o->seconds &&
            (o->frame_limit <= 0 || scores->count < o->frame_limit)) {
         vf_frame_score score;
         char name[32], note[64];
-        status = vf_v4l2_read(cam, FRAME_TIMEOUT_MS, &frame, &sequence);
+        int got; /* a webcam always has a next frame */
+        status = vf_frames_next(in, &frame, &frame_info, &got);
         if (status == VF_OK)
             status = vf_score_frame(&frame, &score);
         if (status == VF_OK) {
@@ -47,6 +49,7 @@ static vf_status capture(vf_v4l2 *cam, const vf_ingest_options *o, const char *c
             status = vf__score_list_push(scores, &score);
         if (status != VF_OK)
             break;
+        uint32_t sequence = (uint32_t)frame_info.index; /* the driver's frame number */
         if (scores->count > 1 && sequence - previous > 1)
             stats->dropped += (long)(sequence - previous - 1);
         previous = sequence;
@@ -62,16 +65,17 @@ static vf_status capture(vf_v4l2 *cam, const vf_ingest_options *o, const char *c
     return status;
 }
 
-/* Open, start and capture; the device is closed again before returning. */
+/* Open (through the frame source, vf/frames.h) and capture; the device is closed again before
+ * returning. */
 static vf_status record(const char *device, const vf_ingest_options *o, const char *capture_dir,
                         score_list *scores, capture_stats *stats, json_t *report)
 {
     vf_v4l2_request request = {o->width, o->height, o->pixel_format, 0};
-    vf_v4l2 *cam;
-    vf_status status = vf_v4l2_open(device, o->ops, &request, &cam);
+    vf_frames in;
+    vf_status status = vf_frames_open_v4l2(device, o->ops, &request, &in);
     if (status != VF_OK)
         return status;
-    const vf_v4l2_info *info = vf_v4l2_get_info(cam);
+    const vf_v4l2_info *info = vf_v4l2_get_info(in.camera);
     char fourcc[5];
     vf_fourcc_text(info->pixel_format, fourcc);
     vf_info("%s (%s): %dx%d %s, capturing for %.3g s", device, info->card, info->width,
@@ -82,10 +86,8 @@ static vf_status record(const char *device, const vf_ingest_options *o, const ch
     json_object_set_new(report, "width", json_integer(info->width));
     json_object_set_new(report, "height", json_integer(info->height));
     json_object_set_new(report, "nominal_fps", json_real(info->fps));
-    status = vf_v4l2_start(cam);
-    if (status == VF_OK)
-        status = capture(cam, o, capture_dir, scores, stats);
-    vf_v4l2_close(cam);
+    status = capture(&in, o, capture_dir, scores, stats);
+    vf_frames_close(&in);
     return status;
 }
 

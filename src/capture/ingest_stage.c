@@ -246,8 +246,12 @@ static vf_status run_in_stage(const char *root, const vf_ingest_request *opt, im
                vf_path_join(first, sizeof first, stage.dir, "images/r_000.png") == VF_OK &&
                vf_is_file(first);
     if (status == VF_OK) {
-        *summary_out = json_deep_copy(summary);
+        json_t *copy = json_deep_copy(summary); /* the commit takes summary */
         status = vf_stage_commit(&stage, params, summary);
+        if (status == VF_OK)
+            *summary_out = copy;
+        else
+            json_decref(copy);
     } else {
         json_decref(params);
         json_decref(summary);

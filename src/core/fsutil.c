@@ -187,11 +187,21 @@ vf_status vf_copy_file(const char *src, const char *dst)
     return status;
 }
 
-static int is_image_name(const char *name)
+int vf_path_has_extension(const char *path, const char *const *exts)
 {
-    const char *dot = strrchr(name, '.');
-    return name[0] != '.' && dot &&
-           (!strcasecmp(dot, ".jpg") || !strcasecmp(dot, ".jpeg") || !strcasecmp(dot, ".png"));
+    const char *dot = strrchr(path, '.');
+    if (!dot || strchr(dot, '/'))
+        return 0;
+    for (; *exts; exts++)
+        if (!strcasecmp(dot + 1, *exts))
+            return 1;
+    return 0;
+}
+
+int vf_is_image_name(const char *path)
+{
+    static const char *const exts[] = {"jpg", "jpeg", "png", NULL};
+    return vf_path_has_extension(path, exts);
 }
 
 static int compare_names(const void *a, const void *b)
@@ -199,7 +209,8 @@ static int compare_names(const void *a, const void *b)
     return strcmp(*(char *const *)a, *(char *const *)b);
 }
 
-vf_status vf_list_images(const char *folder, char ***names, int *count)
+vf_status vf_list_folder(const char *folder, int (*keep)(const char *name), char ***names,
+                         int *count)
 {
     *names = NULL;
     *count = 0;
@@ -210,7 +221,7 @@ vf_status vf_list_images(const char *folder, char ***names, int *count)
     int capacity = 0;
     vf_status status = VF_OK;
     while (status == VF_OK && (entry = readdir(dir))) {
-        if (!is_image_name(entry->d_name))
+        if (entry->d_name[0] == '.' || !keep(entry->d_name))
             continue;
         if (*count == capacity) {
             capacity = capacity ? 2 * capacity : 64;
@@ -235,6 +246,11 @@ vf_status vf_list_images(const char *folder, char ***names, int *count)
         qsort(*names, (size_t)*count, sizeof **names, compare_names);
     }
     return status;
+}
+
+vf_status vf_list_images(const char *folder, char ***names, int *count)
+{
+    return vf_list_folder(folder, vf_is_image_name, names, count);
 }
 
 void vf_free_names(char **names, int count)

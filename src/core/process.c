@@ -23,14 +23,18 @@ void vf_args_add(vf_args *args, const char *item)
     if (args->count + 2 > args->capacity) {
         int capacity = args->capacity ? 2 * args->capacity : 32;
         char **items = realloc(args->items, (size_t)capacity * sizeof *items);
-        if (!items)
-            return; /* vf_process_run sees the missing terminator and fails */
+        if (!items) {
+            args->failed = 1;
+            return;
+        }
         args->items = items;
         args->capacity = capacity;
     }
     char *copy = strdup(item);
-    if (!copy)
+    if (!copy) {
+        args->failed = 1;
         return;
+    }
     args->items[args->count++] = copy;
     args->items[args->count] = NULL;
 }
@@ -90,7 +94,7 @@ vf_status vf_find_program(const char *env_var, const char *name, const char *ins
 static vf_status spawn(const char *program, const vf_args *args, int out_fd, int channel_fd,
                        pid_t *pid)
 {
-    if (!args->items || args->items[args->count] != NULL)
+    if (args->failed)
         return vf_fail(VF_EINTERNAL, "out of memory building the command line of %s", program);
     char *argv[args->count + 2];
     argv[0] = (char *)program;
@@ -154,9 +158,12 @@ vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
         return status;
     }
     follow_output(fds[0], log, on_line, ctx);
-    int wstatus;
-    while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR)
+    int wstatus = 0;
+    pid_t done;
+    while ((done = waitpid(pid, &wstatus, 0)) < 0 && errno == EINTR)
         ;
+    if (done < 0) /* e.g. SIGCHLD ignored: the child's status is lost, so is its verdict */
+        return vf_fail(VF_EINTERNAL, "cannot learn how %s ended: %s", program, strerror(errno));
     if (WIFEXITED(wstatus))
         *exit_code = WEXITSTATUS(wstatus);
     else if (WIFSIGNALED(wstatus) && signal_out)
@@ -185,17 +192,20 @@ vf_status vf_process_start(const char *program, const vf_args *args, int output_
 int vf_process_finish(int pid, double timeout_s)
 {
     int wstatus = 0;
+    pid_t done;
     for (int waited_ms = 0;; waited_ms += 10) {
-        pid_t done = waitpid((pid_t)pid, &wstatus, WNOHANG);
+        done = waitpid((pid_t)pid, &wstatus, WNOHANG);
         if (done == (pid_t)pid || (done < 0 && errno != EINTR))
             break;
         if (waited_ms >= 1000 * timeout_s) {
             kill((pid_t)pid, SIGKILL);
-            while (waitpid((pid_t)pid, &wstatus, 0) < 0 && errno == EINTR)
+            while ((done = waitpid((pid_t)pid, &wstatus, 0)) < 0 && errno == EINTR)
                 ;
             break;
         }
         usleep(10000);
     }
+    if (done < 0) /* no status to read: never report a success we did not see */
+        return -1;
     return WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
 }

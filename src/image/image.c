@@ -112,6 +112,26 @@ vf_status vf_image_load_rgb(const char *path, const float background[3], vf_imag
     return status;
 }
 
+vf_status vf_image_orientation(const char *path, int *orientation)
+{
+    int w, h, channels;
+    return vf__oiio_info(path, &w, &h, &channels, orientation);
+}
+
+void vf_orientation_source(int orientation, int w, int h, int u, int v, int *x, int *y)
+{
+    switch (orientation) {
+    case 2: *x = w - 1 - u, *y = v; break;
+    case 3: *x = w - 1 - u, *y = h - 1 - v; break;
+    case 4: *x = u, *y = h - 1 - v; break;
+    case 5: *x = v, *y = u; break;
+    case 6: *x = v, *y = h - 1 - u; break;
+    case 7: *x = w - 1 - v, *y = h - 1 - u; break;
+    case 8: *x = w - 1 - v, *y = u; break;
+    default: *x = u, *y = v; break;
+    }
+}
+
 vf_status vf_image_reorient(const vf_image *src, int orientation, vf_image *out)
 {
     if (orientation < 1 || orientation > 8)
@@ -124,17 +144,8 @@ vf_status vf_image_reorient(const vf_image *src, int orientation, vf_image *out)
     size_t c = (size_t)src->channels;
     for (int v = 0; v < img.height; v++)
         for (int u = 0; u < img.width; u++) {
-            int x, y; /* the stored pixel shown at (u, v) */
-            switch (orientation) {
-            case 2: x = w - 1 - u, y = v; break;
-            case 3: x = w - 1 - u, y = h - 1 - v; break;
-            case 4: x = u, y = h - 1 - v; break;
-            case 5: x = v, y = u; break;
-            case 6: x = v, y = h - 1 - u; break;
-            case 7: x = w - 1 - v, y = h - 1 - u; break;
-            case 8: x = w - 1 - v, y = u; break;
-            default: x = u, y = v; break;
-            }
+            int x, y;
+            vf_orientation_source(orientation, w, h, u, v, &x, &y);
             memcpy(img.data + ((size_t)v * img.width + u) * c,
                    src->data + ((size_t)y * w + x) * c, c * sizeof(float));
         }

@@ -1,5 +1,5 @@
 /* The plain-C half of vf/rgb8.h: memory and comparison. Codecs and resizing are in
- * rgb8_cv.cpp. */
+ * rgb8_cv.cpp, reading a photo upright in rgb8_load.c. */
 #include "vf/rgb8.h"
 
 #include <stdint.h>

@@ -2,6 +2,7 @@
 // OpenCV works in BGR; every frame crosses this boundary as RGB. Every cv::Exception becomes a
 // vf_status with a one-line message.
 #include "vf/rgb8.h"
+#include "rgb8_cv.h"
 
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -140,15 +141,13 @@ extern "C" vf_status vf_rgb8_encode_jpeg(const vf_rgb8 *img, int quality, unsign
     return VF_OK;
 }
 
-extern "C" vf_status vf_rgb8_load(const char *path, vf_rgb8 *out)
+extern "C" vf_status vf__cv_read(const char *path, vf_rgb8 *out)
 {
-    if (!vf_is_file(path))
-        return vf_fail(VF_EINPUT, "cannot read %s: no such file", path);
     QuietLog quiet;
     try {
-        // IMREAD_COLOR applies a JPEG's EXIF orientation; other formats keep their alpha.
-        int flags = is_jpeg_name(path) ? cv::IMREAD_COLOR : cv::IMREAD_UNCHANGED;
-        cv::Mat img = cv::imread(path, flags);
+        // As stored: IMREAD_UNCHANGED keeps alpha (composited below) and ignores EXIF
+        // orientation, which rgb8.c applies by the project's one rule (vf_image_orientation).
+        cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
         if (img.empty())
             return vf_fail(VF_EINPUT, "cannot read %s: not an image OpenCV can decode", path);
         return store_bgr(to_bgr8(img), out);

@@ -3,6 +3,7 @@
  * matching and PnP calls are in localize_cv.cpp, the refinement in
  * pose_ceres.cpp, the descriptors' source in localize_db.c. */
 #include "vf/localize.h"
+#include "vf/sfm_export.h"
 
 #include <jansson.h>
 #include <math.h>
@@ -32,63 +33,6 @@ void vf_localize_defaults(vf_localize_options *opt)
                                  .min_inliers = 30, .min_inlier_ratio = 0.2};
 }
 
-/* ---- normalization.json ---- */
-
-static vf_status read_similarity(const json_t *obj, const char *path, const char *key,
-                                 vf_similarity *s)
-{
-    const json_t *o = json_object_get(obj, key);
-    const json_t *rot = json_object_get(o, "rotation"), *t = json_object_get(o, "translation");
-    s->scale = json_number_value(json_object_get(o, "scale"));
-    int ok = s->scale > 1e-9 && s->scale < 1e9 && json_array_size(rot) == 3 &&
-             json_array_size(t) == 3;
-    for (int r = 0; ok && r < 3; r++) {
-        const json_t *row = json_array_get(rot, (size_t)r);
-        s->t[r] = json_number_value(json_array_get(t, (size_t)r));
-        ok = json_array_size(row) == 3 && json_is_number(json_array_get(t, (size_t)r)) &&
-             fabs(s->t[r]) < 1e9;
-        for (int c = 0; ok && c < 3; c++) {
-            const json_t *x = json_array_get(row, (size_t)c);
-            s->R[3 * r + c] = json_number_value(x);
-            ok = json_is_number(x);
-        }
-    }
-    /* a rotation: orthonormal rows (R R^T = I) and det +1 */
-    for (int a = 0; ok && a < 3; a++)
-        for (int b = 0; ok && b < 3; b++) {
-            double dot = 0;
-            for (int k = 0; k < 3; k++)
-                dot += s->R[3 * a + k] * s->R[3 * b + k];
-            ok = fabs(dot - (a == b)) < 1e-6;
-        }
-    if (ok)
-        ok = vf_mat3_det(s->R) > 0;
-    if (!ok)
-        return vf_fail(VF_EINPUT, "%s: \"%s\" needs a scale (1e-9 to 1e9), a rotation (3x3, "
-                       "orthonormal) and a translation (3 numbers)", path, key);
-    return VF_OK;
-}
-
-vf_status vf_normalization_load(const char *path, vf_similarity *object_from_colmap,
-                                vf_similarity *colmap_from_object)
-{
-    json_t *doc;
-    vf_status status = vf_json_load(path, &doc);
-    if (status != VF_OK)
-        return status;
-    vf_similarity fwd, back;
-    status = read_similarity(doc, path, "object_from_colmap", &fwd);
-    json_decref(doc);
-    if (status != VF_OK)
-        return status;
-    back = vf_similarity_inverse(&fwd);
-    if (object_from_colmap)
-        *object_from_colmap = fwd;
-    if (colmap_from_object)
-        *colmap_from_object = back;
-    return VF_OK;
-}
-
 /* ---- the map ---- */
 
 static vf_status load_map(vf_localizer *loc, const char *ws_root)
@@ -103,7 +47,7 @@ static vf_status load_map(vf_localizer *loc, const char *ws_root)
     if (status == VF_OK)
         status = vf_colmap_model_load(path, &loc->model);
     if (status == VF_OK)
-        status = vf_path_join(path, sizeof path, poses, "normalization.json");
+        status = vf_path_join(path, sizeof path, poses, VF_NORMALIZATION_FILE);
     if (status == VF_OK)
         status = vf_normalization_load(path, &loc->object_from_colmap, NULL);
     if (status == VF_OK)

@@ -47,7 +47,7 @@ static vf_status load_inputs(export_run *run, const vf_workspace *ws)
     char path[VF_PATH_MAX];
     vf_status status = vf_attack_file_load_workspace(ws, &run->attack);
     if (status == VF_OK)
-        status = vf_workspace_path(ws, "poses", "normalization.json", path, sizeof path);
+        status = vf_workspace_path(ws, "poses", VF_NORMALIZATION_FILE, path, sizeof path);
     if (status == VF_OK && vf_is_file(path)) {
         status = vf_normalization_load(path, NULL, &run->colmap_from_object);
         run->has_colmap = status == VF_OK;

@@ -108,7 +108,7 @@ static vf_status capture(reshoot_run *run)
 {
     vf_frames in;
     char *video = (char *)run->opt->video;
-    vf_status status = run->opt->device ? vf_frames_open_v4l2(run->opt->device, &in)
+    vf_status status = run->opt->device ? vf_frames_open_v4l2(run->opt->device, NULL, NULL, &in)
                                         : vf_frames_open(&video, 1, &in);
     if (status != VF_OK)
         return status;

@@ -87,7 +87,7 @@ vf_status vf_colmap_run(vf_colmap *colmap, const char *label, size_t total, cons
                         double *seconds)
 {
     colmap->last_exit = -1;
-    if (args->count == 0 || args->items[args->count] != NULL)
+    if (args->count == 0 || args->failed)
         return vf_fail(VF_EINTERNAL, "out of memory building the COLMAP command line");
     fprintf(colmap->log, "\n$ colmap");
     for (int i = 0; i < args->count; i++)

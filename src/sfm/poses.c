@@ -290,7 +290,7 @@ static vf_status export_outputs(poses_run *run, vf_normalization *norm)
     vf_status status = normalize_model(run, norm);
     const vf_similarity *s = &norm->object_from_world;
     if (status == VF_OK)
-        status = vf_path_join(path, sizeof path, run->stage.dir, "normalization.json");
+        status = vf_path_join(path, sizeof path, run->stage.dir, VF_NORMALIZATION_FILE);
     if (status == VF_OK)
         status = vf_sfm_save_normalization(path, norm);
     if (status == VF_OK)

@@ -13,13 +13,12 @@
 #include "vf/workspace.h"
 
 #define EVAL_CHUNK 16
-#define MAX_LABELS 64
 
 typedef struct vbench_set {
     int object_count, image_count;
     char **object_names;
     int *label_count;                 /* per object */
-    int (*labels)[MAX_LABELS];        /* per object */
+    int (*labels)[VF_MAX_LABELS];        /* per object */
     char **files;                     /* per image, full paths */
     int *object;                      /* per image */
     vf_vbench_split *split;           /* per image */
@@ -51,7 +50,7 @@ static vf_status read_objects(const json_t *objects, const char *index_path, vbe
         const json_t *indices = json_object_get(json_object_get(obj, "label"), "indices");
         const char *name = json_string_value(json_object_get(obj, "name"));
         if (!name || !json_is_array(indices) || json_array_size(indices) == 0 ||
-            json_array_size(indices) > MAX_LABELS)
+            json_array_size(indices) > VF_MAX_LABELS)
             return vf_fail(VF_EINPUT, "%s: object %d has no name or label indices", index_path, o);
         s->object_names[o] = strdup(name);
         s->label_count[o] = (int)json_array_size(indices);
@@ -108,10 +107,7 @@ static vf_status load_set(const char *dir, vbench_set *s)
 static int is_correct(const vbench_set *s, int image, int top1)
 {
     int o = s->object[image];
-    for (int k = 0; k < s->label_count[o]; k++)
-        if (s->labels[o][k] == top1)
-            return 1;
-    return 0;
+    return vf_label_set_contains(s->labels[o], s->label_count[o], top1);
 }
 
 /* Rows of one model: objects x splits, then the all-objects row of each split. */

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "viewfool_internal.h"
+#include "vf/json.h"
 
 #define STATE_FORMAT 2 /* 2: moments over (mu, sigma), not (mu, log sigma) */
 
@@ -17,14 +18,6 @@
 static json_t *real_or_null(double x)
 {
     return isfinite(x) ? json_real(x) : json_null();
-}
-
-static json_t *doubles_to_json(const double *x, int n)
-{
-    json_t *array = json_array();
-    for (int i = 0; i < n; i++)
-        json_array_append_new(array, real_or_null(x[i]));
-    return array;
 }
 
 /* Read exactly n numbers from a JSON array (null reads as -inf); name is for messages. */
@@ -91,8 +84,8 @@ json_t *vf_attack_state_to_json(const vf_attack_state *st)
     int k = st->components, n_params = k * VF_ATTACK_COMPONENT_PARAMS;
     json_t *mu = json_array(), *sigma = json_array(), *rng = json_array(), *hist = json_array();
     for (int c = 0; c < k; c++) {
-        json_array_append_new(mu, doubles_to_json(st->mu[c], VF_VIEW_DIM));
-        json_array_append_new(sigma, doubles_to_json(st->sigma[c], VF_VIEW_DIM));
+        json_array_append_new(mu, vf_json_doubles(st->mu[c], VF_VIEW_DIM));
+        json_array_append_new(sigma, vf_json_doubles(st->sigma[c], VF_VIEW_DIM));
     }
     for (int i = 0; i < 4; i++) {
         char hex[17];
@@ -102,16 +95,16 @@ json_t *vf_attack_state_to_json(const vf_attack_state *st)
     for (int t = 0; t < st->step; t++) {
         const vf_attack_record *r = &st->history[t];
         double row[4] = {r->mean_loss, r->max_loss, r->fooled_rate, r->entropy};
-        json_array_append_new(hist, doubles_to_json(row, 4));
+        json_array_append_new(hist, vf_json_doubles(row, 4));
     }
     return json_pack("{s:i, s:i, s:i, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o}",
                      "format", STATE_FORMAT, "components", k, "step", st->step, "mu", mu,
-                     "sigma", sigma, "logit", doubles_to_json(st->logit, k), "moment1",
-                     doubles_to_json(st->moment1, n_params), "moment2",
-                     doubles_to_json(st->moment2, n_params), "rng", rng, "last_best_view",
-                     doubles_to_json(st->last_best_view, VF_VIEW_DIM), "last_best_loss",
+                     "sigma", sigma, "logit", vf_json_doubles(st->logit, k), "moment1",
+                     vf_json_doubles(st->moment1, n_params), "moment2",
+                     vf_json_doubles(st->moment2, n_params), "rng", rng, "last_best_view",
+                     vf_json_doubles(st->last_best_view, VF_VIEW_DIM), "last_best_loss",
                      real_or_null(st->last_best_loss), "best_view",
-                     doubles_to_json(st->best_view, VF_VIEW_DIM), "best_loss",
+                     vf_json_doubles(st->best_view, VF_VIEW_DIM), "best_loss",
                      real_or_null(st->best_loss), "history", hist);
 }
 
@@ -211,8 +204,8 @@ json_t *vf_attack_config_to_json(const vf_attack_config *cfg)
 {
     char seed[24];
     snprintf(seed, sizeof seed, "%" PRIu64, cfg->seed);
-    json_t *bounds = json_pack("{s:o, s:o}", "lo", doubles_to_json(cfg->bounds.lo, VF_VIEW_DIM),
-                               "hi", doubles_to_json(cfg->bounds.hi, VF_VIEW_DIM));
+    json_t *bounds = json_pack("{s:o, s:o}", "lo", vf_json_doubles(cfg->bounds.lo, VF_VIEW_DIM),
+                               "hi", vf_json_doubles(cfg->bounds.hi, VF_VIEW_DIM));
     json_t *json = json_pack(
         "{s:s, s:o, s:i, s:i, s:f, s:f, s:s, s:f, s:f, s:f}", "method",
         cfg->method == VF_ATTACK_PEPG ? "pepg" : "nes", "bounds", bounds, "samples", cfg->samples,

@@ -15,7 +15,7 @@ static vf_status load_text(const char *name, const char *json, vf_dataset *ds)
     return vf_dataset_load(path, ds);
 }
 
-int main(void)
+static void test_datasets(void)
 {
     vf_dataset ds;
     CHECK(vf_dataset_load(vf_test_shared("data/nerf_synthetic/chair/transforms_train.json"), &ds) ==
@@ -121,5 +121,11 @@ int main(void)
     CHECK(load_text("hostile.json", json, &ds) == VF_EINPUT &&
               strstr(vf_error_message(), "transform_matrix[2][3]"),
           "a huge matrix entry refused: %s", vf_error_message());
+}
+
+int main(int argc, char **argv)
+{
+    check_args(argc, argv);
+    CHECK_CASE(test_datasets);
     return check_finish();
 }
