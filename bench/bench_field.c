@@ -177,6 +177,7 @@ static void apply_setting(vf_field_train_options *o, const char *text)
     else if (!strcmp(name, "prune_alpha")) o->prune_alpha = (float)v;
     else if (!strcmp(name, "box_scale")) o->box_scale = (float)v;
     else if (!strcmp(name, "background_scale")) o->background_scale = (float)v;
+    else if (!strcmp(name, "carve_share")) o->carve_share = (float)v;
     else if (!strcmp(name, "surroundings")) o->surroundings = (vf_field_surroundings)v;
     else if (!strcmp(name, "steps")) { o->steps = (int)v; o->seconds = 0; }
     else if (!strcmp(name, "seed")) o->seed = (uint64_t)v;
@@ -190,6 +191,7 @@ static double progress_every = 5;
 
 typedef struct run_result {
     double psnr, ssim, train_seconds, peak_mib;
+    double psnr_object; /* inside the masks of cut-out (RGBA) photos; NAN for opaque ones */
     double eval_ms; /* rendering and scoring one held-out view */
     int steps;
 } run_result;
@@ -246,13 +248,19 @@ static void dump_pair(const char *name, int view, const vf_image *photo, const v
 static void evaluate(const char *name, const vf_field *f, const view_set *test, const float bg[3],
                      run_result *r)
 {
-    double psnr = 0, ssim = 0, t0 = vf_now();
+    double psnr = 0, ssim = 0, object = 0, t0 = vf_now();
+    int masked = 0;
     for (int i = 0; i < test->count; i++) {
         vf_image render = {0}, truth = {0};
         if (vf_field_render(f, &test->cameras[i], test->c2w + 16 * i, &render) != VF_OK)
             die("rendering");
         target_rgb(&test->images[i], bg, &truth);
         const double p = vf_image_psnr(&render, &truth);
+        double po = test->images[i].channels == 4
+                        ? vf_image_psnr_masked(&render, &truth, &test->images[i])
+                        : -1;
+        if (po >= 0)
+            object += po, masked++;
         psnr += p;
         ssim += vf_image_ssim(&render, &truth);
         if (dump_dir)
@@ -262,6 +270,7 @@ static void evaluate(const char *name, const vf_field *f, const view_set *test, 
     }
     r->psnr = psnr / test->count;
     r->ssim = ssim / test->count;
+    r->psnr_object = masked ? object / masked : NAN;
     r->eval_ms = (vf_now() - t0) * 1000 / test->count;
 }
 
@@ -310,6 +319,8 @@ static void print_run(const char *scene, double minutes, const run_result *r, do
     printf("%-6s %4.1f min  %5d steps  PSNR %6.2f dB  SSIM %.4f  peak %6.0f MiB  %.0f ms/view  %s\n",
            scene, minutes, r->steps, r->psnr, r->ssim, r->peak_mib, r->eval_ms,
            target > 0 ? (r->psnr >= target ? "(target met)" : "(BELOW TARGET)") : "");
+    if (isfinite(r->psnr_object))
+        printf("%-6s PSNR inside the object's masks %.2f dB\n", scene, r->psnr_object);
     fflush(stdout);
 }
 

@@ -60,6 +60,9 @@ typedef struct vf_colmap_model {
 /* Read cameras.txt, images.txt and points3D.txt from `dir`. VF_EINPUT naming the file and line
  * when one is missing or malformed. */
 vf_status vf_colmap_model_load(const char *dir, vf_colmap_model *model);
+/* Read only points3D.txt from `dir` (a poses stage's WS/poses holds one in the object frame);
+ * the model has no cameras or images. */
+vf_status vf_colmap_points_load(const char *dir, vf_colmap_model *model);
 void vf_colmap_model_free(vf_colmap_model *model);
 
 /* The camera or image with this id, or NULL. */

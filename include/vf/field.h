@@ -145,6 +145,10 @@ typedef struct vf_field_train_options {
     float opaque;               /* opaque photos: weight of a loss on the transmittance a ray
                                    leaves for the background colour (every pixel sees a surface;
                                    without it a room trains into haze over the background) */
+    float carve_share;       /* photos with alpha: a point of the box is carved away when at
+                                least this share of the views that see it find it transparent
+                                (0: one view is enough, for exact masks; cut-outs of real
+                                photos err here and there, so object mode asks for more) */
     float prune_alpha;       /* by 70% of the budget (and 1200 steps at the earliest), cells
                                 where no corner reaches this opacity per step are pruned (0: no
                                 pruning ramp; see train.c) */

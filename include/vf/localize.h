@@ -76,6 +76,11 @@ void vf_localizer_close(vf_localizer *loc);
 /* Map size, for reports: 3D points and descriptors (observations) in the index. */
 void vf_localizer_map_size(const vf_localizer *loc, int *points, int *descriptors);
 
+/* The camera a frame of width x height is localized with: the calibration given, else the
+ * capture's camera of the same aspect ratio, scaled (lens included). VF_EINPUT when the frame
+ * fits neither (another aspect ratio or orientation). */
+vf_status vf_localizer_camera(const vf_localizer *loc, int width, int height, vf_camera *cam);
+
 /* Localize one frame. A frame that cannot be localized is VF_OK with result->localized = 0
  * and the reason; errors are for frames that cannot be used at all (a size whose aspect ratio
  * does not fit the camera) or internal failures. */

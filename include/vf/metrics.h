@@ -20,6 +20,9 @@ double vf_image_mse(const vf_image *a, const vf_image *b);
 /* Peak signal-to-noise ratio in dB, -10 log10(MSE); 100 for identical images, -1 when the
  * sizes differ. */
 double vf_image_psnr(const vf_image *a, const vf_image *b);
+/* PSNR over the pixels where mask (an RGBA image of the same size) is opaque (alpha > 0.5),
+ * RGB channels only; -1 when the sizes differ or no pixel is opaque. */
+double vf_image_psnr_masked(const vf_image *a, const vf_image *b, const vf_image *mask);
 
 /* Structural similarity in [-1, 1]; -2 when the sizes differ or the image is smaller than
  * the window. */

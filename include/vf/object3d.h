@@ -58,7 +58,11 @@ int vf_object3d_is_model(const char *path);
 typedef struct vf_object3d_capture {
     int views;              /* training views on the upper hemisphere (default 100) */
     int test_views;         /* held-out views, other random ones (default 25) */
-    int size;               /* square render side in pixels (default 200, as NeRF-synthetic) */
+    int size;               /* square render side in pixels (default 256: the classifier
+                               camera's 224 crop of the 256-resized view then samples the field
+                               at its training resolution; measured on the water bottle at 2300
+                               steps: field natural accuracy 67% against 61% at 200 px, the
+                               object's own 84%) */
     int samples;            /* Cycles samples a pixel (default 32; no denoiser in Debian's build) */
     double distance;        /* camera distance (default 4) */
     double camera_angle_x;  /* horizontal field of view, radians (default the NeRF camera) */

@@ -9,7 +9,12 @@
  * "center_viewpoint", "tolerance_percent", "model", "engine", "label", "kept" {"frames",
  * "misclassified", "asr", "interval95", "predicted"}, "natural" {... "error_rate" ...},
  * "rejected" {"blurry", "not_localized", "out_of_tolerance", "total"}, "frames",
- * "localize_fps", "frames_detail" [per frame]} and frames.csv. */
+ * "localize_fps", "mode", "frames_detail" [per frame]} and frames.csv.
+ *
+ * When the field was trained in object mode (vf/train.h object_only), each localized frame is
+ * cut out the same way (vf/cutout.h, posed by its localization) and classified on white, so
+ * the attack and the physical measurement see the same thing ("mode": "object", and each
+ * frame's "object_coverage"). */
 #ifndef VF_SCORE_H
 #define VF_SCORE_H
 

@@ -12,9 +12,9 @@
  * composited on the field's background) and shown beside its render in held_out.jpg. The
  * trainer (vf/field.h) checkpoints into the staging folder every 30 s; a later run resumes
  * from that checkpoint unless `restart` is set, and the checkpoint goes only once the stage is
- * committed. Output: WS/train/model.vff (VF_FIELD_FILE), report.json (views, held_out_views,
- * steps, seconds, surroundings, field, grid, bytes, held_out_psnr/ssim, held_out [per view]),
- * held_out.jpg. */
+ * committed. Output: WS/train/model.vff (VF_FIELD_FILE), report.json (mode "scene" or
+ * "object", views, held_out_views, steps, seconds, surroundings, field, grid, bytes,
+ * held_out_psnr/ssim, held_out [per view]), held_out.jpg. */
 #ifndef VF_TRAIN_H
 #define VF_TRAIN_H
 
@@ -34,6 +34,13 @@ typedef struct vf_train_options {
     int holdout;    /* hold out every holdout-th view for scoring; 0 none (10) */
     vf_field_surroundings surroundings; /* VF_SURROUNDINGS_AUTO, see vf/field.h */
     int restart;                        /* ignore a checkpoint of an interrupted run */
+    /* Object mode (vf/cutout.h): cut the object out of every photo with the help of the
+     * poses stage's sparse points and train on it alone, on white, as on background-removed
+     * photos. WS/train/object/ keeps the cut-out views (RGBA), their transforms.json and
+     * masks.jpg; report.json says "mode": "object" with the cut's figures and the held-out
+     * PSNR inside the masks (held_out_psnr_object). Needs a poses stage (a posed import has
+     * no sparse points). */
+    int object_only;
 } vf_train_options;
 
 void vf_train_defaults(vf_train_options *o);

@@ -128,24 +128,28 @@ static void free_masks(const vf_field_trainer *t, uint8_t **masks)
     free(masks);
 }
 
-/* Whether world point p is outside the visual hull: some masked view sees it on a (dilated)
- * transparent pixel, or no view sees it at all (nothing was filmed there: a capture that
+/* Whether world point p is outside the visual hull: masked views see it on a (dilated)
+ * transparent pixel (one is enough for exact masks; opt.carve_share of the views that see it
+ * for masks that may err), or no view sees it at all (nothing was filmed there: a capture that
  * covers only an arc would otherwise keep every corner of the box, and the field would fill
  * them with fog). */
 static int carved(const vf_field_trainer *t, uint8_t *const *masks, const double p[3])
 {
-    int seen = 0;
+    int seen = 0, transparent = 0;
     for (int i = 0; i < t->view_count; i++) {
         const train_view *v = &t->views[i];
         double u, y, depth;
         if (!project(v, p, &u, &y, &depth) || u < 0 || y < 0 || u >= v->camera.width ||
             y >= v->camera.height)
             continue;
-        if (masks[i] && !masks[i][(size_t)y * v->camera.width + (size_t)u])
-            return 1;
-        seen = 1;
+        seen++;
+        if (masks[i] && !masks[i][(size_t)y * v->camera.width + (size_t)u]) {
+            if (!(t->opt.carve_share > 0))
+                return 1;
+            transparent++;
+        }
     }
-    return !seen;
+    return !seen || (transparent > 0 && transparent >= t->opt.carve_share * seen);
 }
 
 /* Carve a lattice of n^3 points over [lo, hi]; shrink [lo, hi] to the bounding box of what

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/cutout.h"
 #include "vf/dataset.h"
 #include "vf/log.h"
 #include "vf/metrics.h"
@@ -13,6 +14,7 @@
 
 #define CHECKPOINT_SECONDS 30.0
 #define CHECKPOINT_FILE "checkpoint.vfc"
+#define OBJECT_CARVE_SHARE 0.25f
 
 void vf_train_defaults(vf_train_options *o)
 {
@@ -59,6 +61,43 @@ static vf_status add_training_views(vf_field_trainer *t, const vf_dataset *views
     return status;
 }
 
+/* Object mode: replace the views by the object cut out of each (vf/cutout.h), written into
+ * the staging folder's object/ (kept from an interrupted run). */
+static vf_status cut_out_object(const vf_workspace *ws, const char *stage_dir, vf_dataset *views,
+                                json_t **cut_report)
+{
+    char points_dir[VF_PATH_MAX], out_dir[VF_PATH_MAX], kept[VF_PATH_MAX];
+    vf_status status = vf_workspace_path(ws, "poses", "", points_dir, sizeof points_dir);
+    if (status == VF_OK && !vf_workspace_has_stage(ws, "poses"))
+        return vf_fail(VF_EINPUT, "object mode needs the sparse points of 'vfcapture poses'; %s "
+                                  "is a posed import without them",
+                       ws->root);
+    if (status == VF_OK)
+        status = vf_path_join(out_dir, sizeof out_dir, stage_dir, "object");
+    if (status == VF_OK)
+        status = vf_path_join(kept, sizeof kept, out_dir, "cutout.json");
+    vf_dataset cut = {0};
+    if (status == VF_OK && vf_is_file(kept) && vf_json_load(kept, cut_report) == VF_OK) {
+        char transforms[VF_PATH_MAX];
+        status = vf_path_join(transforms, sizeof transforms, out_dir, "transforms.json");
+        if (status == VF_OK)
+            status = vf_dataset_load(transforms, &cut);
+    } else if (status == VF_OK) {
+        vf_cutout_options o;
+        vf_cutout_defaults(&o);
+        status = vf_cutout_views(views, points_dir, out_dir, &o, &cut, cut_report);
+        if (status == VF_OK)
+            status = vf_json_save(kept, *cut_report);
+    }
+    if (status != VF_OK) {
+        vf_dataset_free(&cut);
+        return status;
+    }
+    vf_dataset_free(views);
+    *views = cut;
+    return VF_OK;
+}
+
 /* Train until the budget is used, checkpointing now and then. */
 static vf_status run_training(vf_field_trainer *t, const char *checkpoint,
                               vf_field_train_status *st)
@@ -100,8 +139,10 @@ static vf_status sheet_tile(const vf_image *img, vf_image *out)
  * the first few held-out photos beside their renders. */
 static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int holdout,
                                 const char *sheet_path, json_t *report, double *mean_psnr,
-                                double *mean_ssim)
+                                double *mean_ssim, double *mean_psnr_object)
 {
+    double object_sum = 0;
+    int object_n = 0;
     float bg[3];
     vf_field_background(f, bg);
     json_t *list = json_array();
@@ -117,6 +158,14 @@ static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int 
         status = vf_image_load_rgb(views->frames[i].image_path, bg, &photo);
         if (status == VF_OK)
             status = vf_field_render(f, &views->frames[i].camera, views->frames[i].c2w, &render);
+        vf_image raw = {0}; /* a cut-out view's alpha says where the object is */
+        if (status == VF_OK && (status = vf_image_load(views->frames[i].image_path, &raw)) ==
+                                   VF_OK && raw.channels == 4) {
+            double p = vf_image_psnr_masked(&render, &photo, &raw);
+            if (p >= 0)
+                object_sum += p, object_n++;
+        }
+        vf_image_free(&raw);
         if (status == VF_OK) {
             double psnr = vf_image_psnr(&render, &photo), ssim = vf_image_ssim(&render, &photo);
             psnr_sum += psnr;
@@ -147,6 +196,7 @@ static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int 
         vf_image_free(&sheet[i]);
     *mean_psnr = n ? psnr_sum / n : NAN;
     *mean_ssim = n ? ssim_sum / n : NAN;
+    *mean_psnr_object = object_n ? object_sum / object_n : NAN;
     json_object_set_new(report, "held_out", list);
     return status;
 }
@@ -176,6 +226,8 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
     if (opt->steps)
         topt.steps = opt->steps;
     topt.surroundings = opt->surroundings;
+    if (opt->object_only) /* a cut-out errs in a view or two: the hull keeps what most see */
+        topt.carve_share = OBJECT_CARVE_SHARE;
     vf_field_trainer *t = NULL;
     vf_stage stage;
     char checkpoint[VF_PATH_MAX], model[VF_PATH_MAX], report_path[VF_PATH_MAX];
@@ -186,8 +238,18 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         vf_dataset_free(&views);
         return status;
     }
+    json_t *cut_report = NULL;
+    char object_dir[VF_PATH_MAX];
     if (status == VF_OK)
         status = vf_path_join(checkpoint, sizeof checkpoint, stage.dir, CHECKPOINT_FILE);
+    if (status == VF_OK)
+        status = vf_path_join(object_dir, sizeof object_dir, stage.dir, "object");
+    if (status == VF_OK && vf_is_file(checkpoint) && !opt->object_only != !vf_is_dir(object_dir))
+        status = vf_fail(VF_EINPUT, "an interrupted run trained %s: run the same again, or add "
+                                    "--restart to start over",
+                         opt->object_only ? "on the whole photos" : "in object mode");
+    if (status == VF_OK && opt->object_only)
+        status = cut_out_object(ws, stage.dir, &views, &cut_report);
     if (status == VF_OK)
         status = vf_field_trainer_create(&topt, &t);
     if (status == VF_OK)
@@ -209,14 +271,17 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         status = run_training(t, checkpoint, &st);
     }
 
-    json_t *report = json_object();
-    double psnr = NAN, ssim = NAN;
+    json_t *report = json_pack("{s:s}", "mode", opt->object_only ? "object" : "scene");
+    if (cut_report)
+        json_object_set_new(report, "cutout", cut_report);
+    double psnr = NAN, ssim = NAN, psnr_object = NAN;
     const vf_field *field = t ? vf_field_trainer_field(t) : NULL;
     char sheet[VF_PATH_MAX];
     if (status == VF_OK)
         status = vf_path_join(sheet, sizeof sheet, stage.dir, "held_out.jpg");
     if (status == VF_OK)
-        status = score_held_out(field, &views, opt->holdout, sheet, report, &psnr, &ssim);
+        status = score_held_out(field, &views, opt->holdout, sheet, report, &psnr, &ssim,
+                                &psnr_object);
     if (status == VF_OK)
         status = vf_path_join(model, sizeof model, stage.dir, VF_FIELD_FILE);
     if (status == VF_OK)
@@ -226,6 +291,7 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         vf_field_get_info(field, &info);
         /* what was modelled, which "auto" decides from the photos */
         const char *kind = info.has_background_grid ? "object box + outer grid"
+                           : opt->object_only       ? "object box (object cut out of the photos)"
                            : with_alpha             ? "object box (background-removed photos)"
                                                     : "object box only";
         json_object_update_new(report,
@@ -239,6 +305,8 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         if (held)
             json_object_update_new(
                 report, json_pack("{s:f, s:f}", "held_out_psnr", psnr, "held_out_ssim", ssim));
+        if (held && isfinite(psnr_object))
+            json_object_set_new(report, "held_out_psnr_object", json_real(psnr_object));
         status = vf_path_join(report_path, sizeof report_path, stage.dir, "report.json");
     }
     if (status == VF_OK)
@@ -254,9 +322,11 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                                        ssim, "steps", st.step)
                            : json_pack("{s:i}", "steps", st.step);
     status = vf_stage_commit(&stage,
-                             json_pack("{s:f, s:i, s:i, s:s}", "minutes", opt->minutes, "steps",
-                                       opt->steps, "holdout", opt->holdout, "surroundings",
-                                       vf_field_surroundings_name(opt->surroundings)),
+                             json_pack("{s:f, s:i, s:i, s:s, s:b}", "minutes", opt->minutes,
+                                       "steps", opt->steps, "holdout", opt->holdout,
+                                       "surroundings",
+                                       vf_field_surroundings_name(opt->surroundings),
+                                       "object_only", opt->object_only),
                              json_incref(summary));
     /* The checkpoint goes only once the stage is in place: after a failed commit the next run
      * resumes from it at its end instead of training again. */

@@ -30,6 +30,28 @@ double vf_image_psnr(const vf_image *a, const vf_image *b)
     return mse <= 1e-10 ? 100.0 : -10.0 * log10(mse);
 }
 
+double vf_image_psnr_masked(const vf_image *a, const vf_image *b, const vf_image *mask)
+{
+    if (a->width != b->width || a->height != b->height || mask->width != a->width ||
+        mask->height != a->height || mask->channels != 4 || a->channels < 3 || b->channels < 3)
+        return -1;
+    double sum = 0;
+    size_t count = 0, pixels = (size_t)a->width * a->height;
+    for (size_t i = 0; i < pixels; i++) {
+        if (!(mask->data[4 * i + 3] > 0.5f))
+            continue;
+        for (int c = 0; c < 3; c++) {
+            double d = a->data[i * a->channels + c] - b->data[i * b->channels + c];
+            sum += d * d;
+        }
+        count += 3;
+    }
+    if (!count)
+        return -1;
+    double mse = sum / count;
+    return mse <= 1e-10 ? 100.0 : -10.0 * log10(mse);
+}
+
 /* Separable Gaussian blur of one channel over the valid region: out is
  * (w - 10) x (h - 10). */
 static void blur_valid(const double *in, int w, int h, const double *k, double *tmp, double *out)

@@ -114,9 +114,7 @@ static int same_aspect(int w1, int h1, int w2, int h2)
     return labs(a - b) <= (a > b ? a : b) / 100;
 }
 
-/* The camera for a working frame of width x height: the calibration, else the model's camera
- * with the same aspect ratio, scaled. */
-static vf_status frame_camera(const vf_localizer *loc, int width, int height, vf_camera *cam)
+vf_status vf_localizer_camera(const vf_localizer *loc, int width, int height, vf_camera *cam)
 {
     if (loc->opt.has_camera) {
         const vf_camera *c = &loc->opt.camera;
@@ -284,7 +282,7 @@ static vf_status localize_working_frame(vf_localizer *loc, const vf_rgb8 *frame,
 {
     vf_camera cam;
     frame_work w = {0};
-    vf_status status = frame_camera(loc, frame->width, frame->height, &cam);
+    vf_status status = vf_localizer_camera(loc, frame->width, frame->height, &cam);
     if (status == VF_OK)
         status = vf_loc_sift(frame, loc->opt.max_features, &w.xy, &w.desc, &w.features);
     if (status == VF_OK)

@@ -31,7 +31,7 @@ void vf_object3d_capture_defaults(vf_object3d_capture *c)
 {
     *c = (vf_object3d_capture){.views = 100,
                                .test_views = 25,
-                               .size = 200,
+                               .size = 256, /* see vf/object3d.h */
                                .samples = 32,
                                .distance = VF_CAMERA_DISTANCE,
                                .camera_angle_x = VF_NERF_CAMERA_ANGLE_X,

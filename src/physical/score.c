@@ -9,9 +9,12 @@
 
 #include "vf/attack_file.h"
 #include "vf/classifier.h"
+#include "vf/cutout.h"
+#include "vf/dataset.h"
 #include "vf/frames.h"
 #include "vf/log.h"
 #include "vf/object3d.h"
+#include "vf/pose.h"
 #include "vf/resources.h"
 #include "vf/sharpness.h"
 #include "vf/targets.h"
@@ -39,6 +42,9 @@ typedef struct score_run {
     int frame_count; /* frames in the input (pass 1) */
     json_t *frames;
     double localize_seconds;
+    int object_mode;         /* the field was trained on the object cut out (vf/cutout.h) */
+    vf_object_points object; /* then each frame is cut out the same way before classifying */
+    vf_cutout_options cutout;
 } score_run;
 
 static vf_status open_classifier(score_run *run)
@@ -98,19 +104,62 @@ static vf_status measure_sharpness(score_run *run)
     return status;
 }
 
-/* Classify one frame: the top class and whether it is outside the label set. */
-static vf_status classify(score_run *run, const vf_rgb8 *frame, int *top, float *p)
+/* Object mode, as the train stage did it: the same points and options. */
+static vf_status open_object_mode(score_run *run, const vf_workspace *ws)
+{
+    const json_t *params = json_object_get(vf_workspace_stage_record(ws, "train"), "params");
+    if (!json_is_true(json_object_get(params, "object_only")))
+        return VF_OK;
+    vf_dataset views = {0};
+    char poses[VF_PATH_MAX];
+    vf_status status = vf_dataset_load_training(ws, &views, NULL);
+    double *cameras = status == VF_OK ? malloc((size_t)(views.count + 1) * 3 * sizeof(double))
+                                      : NULL;
+    if (status == VF_OK && !cameras)
+        status = vf_fail(VF_EINTERNAL, "out of memory");
+    for (int i = 0; status == VF_OK && i < views.count; i++)
+        vf_mat4_translation(views.frames[i].c2w, cameras + 3 * i);
+    vf_cutout_defaults(&run->cutout);
+    if (status == VF_OK)
+        status = vf_workspace_path(ws, "poses", "", poses, sizeof poses);
+    if (status == VF_OK)
+        status = vf_object_points_find(poses, cameras, views.count, &run->cutout, &run->object);
+    run->object_mode = status == VF_OK;
+    if (run->object_mode)
+        vf_info("object mode (as the field was trained): each frame's object is cut out and "
+                "classified on white");
+    free(cameras);
+    vf_dataset_free(&views);
+    return status;
+}
+
+/* Classify one frame (in object mode its object cut out onto white, posed by c2w): the top
+ * class; *coverage gets the object's share of the frame (1 outside object mode). */
+static vf_status classify(score_run *run, const vf_rgb8 *frame, const double c2w[16], int *top,
+                          float *p, double *coverage)
 {
     vf_image img = {0};
+    uint8_t *mask = NULL;
     float *probs = malloc(sizeof(float) * VF_NUM_CLASSES);
     vf_status status = probs ? vf_image_alloc(&img, frame->width, frame->height, 3)
                              : vf_fail(VF_EINTERNAL, "out of memory");
+    vf_camera cam;
+    int seen;
+    if (status == VF_OK && run->object_mode &&
+        (status = vf_localizer_camera(run->loc, frame->width, frame->height, &cam)) == VF_OK)
+        status = vf_cutout_mask(frame, &cam, c2w, &run->object, &run->cutout, &mask, &seen);
     if (status == VF_OK) {
-        size_t n = (size_t)frame->width * frame->height * 3;
-        for (size_t i = 0; i < n; i++)
-            img.data[i] = frame->data[i] / 255.0f;
+        size_t n = (size_t)frame->width * frame->height, on = 0;
+        for (size_t i = 0; i < n; i++) {
+            int keep = !mask || mask[i];
+            on += keep;
+            for (int c = 0; c < 3; c++)
+                img.data[3 * i + c] = keep ? frame->data[3 * i + c] / 255.0f : 1.0f;
+        }
+        *coverage = n ? (double)on / n : 0;
         status = vf_classifier_classify_images(run->cls, &img, 1, probs);
     }
+    free(mask);
     if (status == VF_OK)
         vf_topk(probs, 1, top, p);
     vf_image_free(&img);
@@ -159,8 +208,11 @@ static vf_status score_frame(score_run *run, const vf_rgb8 *frame, const vf_fram
     json_object_set_new(row, "box_distance", json_real(worst));
     int top;
     float p;
-    if ((status = classify(run, frame, &top, &p)) != VF_OK)
+    double coverage;
+    if ((status = classify(run, frame, r.c2w_object, &top, &p, &coverage)) != VF_OK)
         return status;
+    if (run->object_mode)
+        json_object_set_new(row, "object_coverage", json_real(coverage));
     json_object_set_new(row, "class", json_integer(top));
     json_object_set_new(row, "class_name", json_string(vf_class_short_name(top)));
     json_object_set_new(row, "confidence", json_real(p));
@@ -221,7 +273,7 @@ static json_t *result_json(const score_run *run)
     const vf_score_options *o = run->opt;
     return json_pack(
         "{s:s, s:s, s:o, s:f, s:s, s:s, s:s, s:o, s:o, s:{s:i, s:i, s:i, s:i}, "
-        "s:i, s:f}",
+        "s:i, s:f, s:s}",
         "workspace", run->root, "center", run->center_name, "center_viewpoint",
         vf_viewpoint_json(&run->center), "tolerance_percent", 100 * o->tolerance, "model",
         vf_classifier_path(run->cls), "engine", vf_classifier_engine(run->cls), "label",
@@ -229,7 +281,8 @@ static json_t *result_json(const score_run *run)
         tally_json(&run->natural, "error_rate"), "rejected", "blurry", run->blurry,
         "not_localized", run->not_localized, "out_of_tolerance", run->out_of_tolerance, "total",
         run->total, "frames", run->total, "localize_fps",
-        run->localize_seconds > 0 ? (run->total - run->blurry) / run->localize_seconds : 0.0);
+        run->localize_seconds > 0 ? (run->total - run->blurry) / run->localize_seconds : 0.0,
+        "mode", run->object_mode ? "object" : "scene");
 }
 
 static vf_status write_frames_csv(const char *path, const json_t *frames)
@@ -323,6 +376,8 @@ vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
     if (status == VF_OK)
         status = vf_localizer_open(ws->root, &o->loc, &run.loc);
     if (status == VF_OK)
+        status = open_object_mode(&run, ws);
+    if (status == VF_OK)
         status = measure_sharpness(&run);
     if (status == VF_OK)
         status = score_frames(&run);
@@ -335,6 +390,7 @@ vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
         }
     }
     vf_localizer_close(run.loc);
+    vf_object_points_free(&run.object);
     vf_classifier_close(run.cls);
     vf_attack_file_free(&run.attack);
     json_decref(run.frames);

@@ -239,6 +239,15 @@ vf_status vf_colmap_model_load(const char *dir, vf_colmap_model *model)
     return status;
 }
 
+vf_status vf_colmap_points_load(const char *dir, vf_colmap_model *model)
+{
+    memset(model, 0, sizeof *model);
+    vf_status status = load_points(dir, model);
+    if (status != VF_OK)
+        vf_colmap_model_free(model);
+    return status;
+}
+
 void vf_colmap_model_free(vf_colmap_model *model)
 {
     free(model->cameras);
