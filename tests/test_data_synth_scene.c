@@ -807,8 +807,8 @@ static void test_cutout(void)
            "%d of %d views over 0.8\n",
            n ? iou_sum / n : 0, iou_min, good, n);
     CHECK(n == TRAIN_VIEWS, "every view compared (%d)", n);
-    /* measured: mean 0.90, 19 of 20 over 0.8 (one view loses a face to the ground's colours:
-     * 0.28) */
+    /* measured: mean 0.90-0.92, 18-19 of 20 over 0.8 (a view or two lose a face to the
+     * ground's colours: 0.28-0.32) */
     CHECK(n && iou_sum / n > 0.8, "mean IoU %.3f", n ? iou_sum / n : 0);
     CHECK(good >= 3 * n / 4, "%d of %d views over 0.8", good, n);
     json_decref(report);

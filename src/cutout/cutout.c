@@ -341,15 +341,18 @@ static void seed_labels(uint8_t *labels, int w, int h, const point2 *pts, int n,
     if (!background) /* the object fills the view: the border is the only hint of background */
         for (int x = 0; x < w; x++)
             labels[x] = labels[(h - 1) * w + x] = VF_GC_PR_BGD;
-    /* points well inside the hull are sure object (those at its edge may be a pixel off) */
-    for (int i = 0; i < n; i++)
-        if (inside_hull(hull, hn, c, 0.8, pts[i]))
-            for (int dy = -2; dy <= 2; dy++)
-                for (int dx = -2; dx <= 2; dx++) {
-                    int x = (int)pts[i].x + dx, y = (int)pts[i].y + dy;
-                    if (x >= 0 && y >= 0 && x < w && y < h && dx * dx + dy * dy <= 4)
-                        labels[y * w + x] = VF_GC_FGD;
-                }
+    /* every point of the object projects inside its silhouette, from any side: its pixel is
+     * sure object (the points well inside the hull get a disc; at the edge a point may be a
+     * pixel off, so only its own pixel) */
+    for (int i = 0; i < n; i++) {
+        int r = inside_hull(hull, hn, c, 0.8, pts[i]) ? 2 : 0;
+        for (int dy = -r; dy <= r; dy++)
+            for (int dx = -r; dx <= r; dx++) {
+                int x = (int)pts[i].x + dx, y = (int)pts[i].y + dy;
+                if (x >= 0 && y >= 0 && x < w && y < h && dx * dx + dy * dy <= r * r)
+                    labels[y * w + x] = VF_GC_FGD;
+            }
+    }
     free(hull);
     free(sorted);
 }
