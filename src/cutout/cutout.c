@@ -181,7 +181,7 @@ vf_status vf_object_points_find(const char *points_dir, const double *cameras, i
     out->candidates = n;
 
     /* the surface: its points and everything behind it (away from the cameras) go */
-    double plane[4];
+    double plane[4] = {0, 0, 1, 0}; /* stays when no three points span a plane */
     int on_plane = dominant_plane(cand, n, o->plane_tolerance, o->seed, plane);
     double mean_camera = 0; /* turn the plane's normal towards the cameras */
     for (int c = 0; n >= 3 && c < camera_count; c++)

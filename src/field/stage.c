@@ -154,13 +154,13 @@ static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int 
     for (int i = 0; i < views->count && status == VF_OK; i++) {
         if (!is_held_out(i, holdout))
             continue;
-        vf_image photo = {0}, render = {0};
-        status = vf_image_load_rgb(views->frames[i].image_path, bg, &photo);
+        vf_image raw = {0}, photo = {0}, render = {0}; /* raw: a cut-out's alpha is its mask */
+        status = vf_image_load(views->frames[i].image_path, &raw);
+        if (status == VF_OK)
+            status = vf_image_to_rgb(&raw, bg, &photo);
         if (status == VF_OK)
             status = vf_field_render(f, &views->frames[i].camera, views->frames[i].c2w, &render);
-        vf_image raw = {0}; /* a cut-out view's alpha says where the object is */
-        if (status == VF_OK && (status = vf_image_load(views->frames[i].image_path, &raw)) ==
-                                   VF_OK && raw.channels == 4) {
+        if (status == VF_OK && raw.channels == 4) {
             double p = vf_image_psnr_masked(&render, &photo, &raw);
             if (p >= 0)
                 object_sum += p, object_n++;
