@@ -91,5 +91,6 @@ int cmd_export(int argc, char **argv);
 int cmd_reshoot(int argc, char **argv);
 int cmd_real(int argc, char **argv);
 int cmd_models(int argc, char **argv);
+int cmd_simulate(int argc, char **argv);
 
 #endif

@@ -19,6 +19,7 @@ static const cli_command commands[] = {
     {"localize", cmd_localize, "where was this frame taken? poses of new photos or video frames"},
     {"reshoot", cmd_reshoot, "guided capture at a target: live advice, saves frames on target"},
     {"score", cmd_score, "physical attack success rate from a re-captured video"},
+    {"simulate", cmd_simulate, "a simulated studio: film a 3D model as a phone would, re-shoot targets"},
     {"classify", cmd_classify, "classify images with an ImageNet model, print top-5"},
     {"models", cmd_models, "list the classifiers found by name, with input size and engine"},
     {"benchmark", cmd_benchmark, "ImageNet-V style set from attacked objects; score classifiers"},

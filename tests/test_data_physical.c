@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "attack_helpers.h"
 #include "check.h"
 #include "poses_helpers.h"
 #include "vf/classifier.h"
@@ -257,7 +258,7 @@ static void check_not_localized(const char *ws)
 }
 
 /* attack.json: v* = the viewpoint of V_STAR_FRAME, fox labels, samples = the training
- * frames' viewpoints (with made-up predictions: export only copies them). */
+ * frames' viewpoints. */
 static void write_attack(const char *ws, const vf_dataset *ours, vf_viewpoint *v_star)
 {
     const vf_frame *f = find_frame(ours, V_STAR_FRAME);
@@ -265,35 +266,12 @@ static void write_attack(const char *ws, const vf_dataset *ours, vf_viewpoint *v
     if (!f)
         return;
     vf_c2w_to_viewpoint(f->c2w, v_star);
-    json_t *samples = json_array(), *preds = json_array();
-    for (int i = 0; i < ours->count; i++) {
-        vf_viewpoint v;
-        vf_c2w_to_viewpoint(ours->frames[i].c2w, &v);
-        json_array_append_new(samples, json_pack("[f,f,f,f,f,f]", v.psi, v.theta, v.phi, v.dx,
-                                                 v.dy, v.dz));
-        json_array_append_new(preds, json_pack("{s:i, s:s, s:f, s:b}", "class", 277, "name",
-                                               "red fox", "confidence", 0.5, "fooled", 0));
-    }
-    json_t *doc = json_pack(
-        "{s:s, s:{s:[i,i,i,i], s:[s,s,s,s]}, s:{s:[f,f,f,f,f,f], s:[f,f,f,f,f,f]}, "
-        "s:[f,f,f,f,f,f], s:o, s:o, s:f, s:f, s:f}",
-        "model", VF_DEFAULT_MODEL, "label", "indices", 277, 278, 279, 280, "names", "red fox",
-        "kit fox", "Arctic fox", "grey fox", "bounds", "lo", -180.0, -30.0, 110.0, -0.5, -1.0,
-        -0.5, "hi", 180.0, 30.0, 250.0, 0.5, 1.0, 0.5, "v_star", v_star->psi, v_star->theta,
-        v_star->phi, v_star->dx, v_star->dy, v_star->dz, "samples", samples,
-        "sample_predictions", preds, "natural_accuracy", 0.9, "asr_v_star", 1.0, "asr_samples",
-        0.5);
-    /* committed as the attack stage, as `vfcapture attack` leaves it */
-    char path[2 * VF_PATH_MAX];
-    vf_workspace w;
-    vf_stage stage;
-    CHECK(vf_workspace_open(ws, 0, &w) == VF_OK && vf_stage_begin(&w, "attack", &stage) == VF_OK,
-          "attack stage begun: %s", vf_error_message());
-    snprintf(path, sizeof path, "%s/attack.json", stage.dir);
-    CHECK(vf_json_save(path, doc) == VF_OK && vf_stage_commit(&stage, NULL, NULL) == VF_OK,
-          "wrote %s", path);
-    vf_workspace_close(&w);
-    json_decref(doc);
+    vf_viewpoint *samples = malloc(sizeof *samples * (size_t)ours->count);
+    for (int i = 0; i < ours->count; i++)
+        vf_c2w_to_viewpoint(ours->frames[i].c2w, &samples[i]);
+    test_label_set fox = {4, {277, 278, 279, 280}, {"red fox", "kit fox", "Arctic fox", "grey fox"}};
+    write_test_attack(ws, &fox, v_star, samples, ours->count);
+    free(samples);
 }
 
 /* Box distance of a known pose from v* (as score measures it). */

@@ -56,6 +56,8 @@ void vf_ingest_defaults(vf_ingest_options *options);
  * "camera", "transforms", or "" when the report does not say (frames put there by hand).
  * Frames of a video or a webcam are in capture order; photos and unknown frames are not. */
 void vf_ingest_source_kind(const char *ws_root, char *kind, size_t size);
+/* The file or folder the frames came from (absolute), or "" as above. */
+void vf_ingest_source_path(const char *ws_root, char *path, size_t size);
 
 /* A video file FFmpeg decodes (two passes: score every frame, then decode again and write the
  * chosen ones). Errors name the file: not a video, no frames, no usable frame. */

@@ -106,6 +106,17 @@ vf_status vf_object3d_render_images(const vf_object3d *obj, const vf_camera *cam
                                     const char *prefix, const char *progress_label,
                                     vf_image *images);
 
+/* Render the frames of a video of the model: camera c2w[i] (object frame) is frame i, the
+ * camera moves from frame to frame and Cycles blurs each frame over `shutter` of the frame
+ * interval (0.5: a 1/60 s shutter at 30 fps; 0: no blur). An animated model keeps its first
+ * frame. Files are dir/PREFIXNNN.png (RGB in the room), kept when already there (a resumed
+ * render). With obj->transform.scale == 0 the model is fitted into the unit sphere as ingest
+ * does it, and *fit (may be NULL) gets that transform; otherwise the given one is used. */
+vf_status vf_object3d_render_video(const vf_object3d *obj, const vf_camera *cam,
+                                   const double *c2w, int n, double shutter, const char *dir,
+                                   const char *prefix, const char *progress_label,
+                                   vf_object3d_transform *fit);
+
 /* ---- the real check: the adversarial viewpoints seen on the object itself ---- */
 
 typedef struct vf_real_options {

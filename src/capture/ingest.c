@@ -51,17 +51,28 @@ void vf__score_list_free(score_list *list)
     memset(list, 0, sizeof *list);
 }
 
-void vf_ingest_source_kind(const char *ws_root, char *kind, size_t size)
+/* One field of the report's "source". */
+static void source_field(const char *ws_root, const char *key, char *out, size_t size)
 {
     char path[VF_PATH_MAX];
     json_t *doc = NULL;
-    snprintf(kind, size, "%s", "");
+    snprintf(out, size, "%s", "");
     if (vf_path_join(path, sizeof path, ws_root, "ingest/" INGEST_REPORT) != VF_OK ||
         !vf_is_file(path) || vf_json_load(path, &doc) != VF_OK)
         return;
-    const char *k = json_string_value(json_object_get(json_object_get(doc, "source"), "kind"));
-    snprintf(kind, size, "%s", k ? k : "");
+    const char *v = json_string_value(json_object_get(json_object_get(doc, "source"), key));
+    snprintf(out, size, "%s", v ? v : "");
     json_decref(doc);
+}
+
+void vf_ingest_source_kind(const char *ws_root, char *kind, size_t size)
+{
+    source_field(ws_root, "kind", kind, size);
+}
+
+void vf_ingest_source_path(const char *ws_root, char *path, size_t size)
+{
+    source_field(ws_root, "path", path, size);
 }
 
 json_t *vf__ingest_report_new(const char *kind, const char *path)

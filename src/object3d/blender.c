@@ -58,10 +58,11 @@ static json_t *job_json(const vf__blender_job *job, const char *info_path)
                               t->center[2], "scale", t->scale);
     }
     const vf_camera *c = &job->camera;
-    return json_pack("{s:s, s:o, s:i, s:i, s:f, s:f, s:f, s:f, s:i, s:s, s:o, s:s, s:s}", "model",
+    return json_pack("{s:s, s:o, s:i, s:i, s:f, s:f, s:f, s:f, s:i, s:s, s:f, s:o, s:s, s:s}", "model",
                      job->model, "normalize", normalize, "width", c->width, "height", c->height,
                      "fx", c->fx, "fy", c->fy, "cx", c->cx, "cy", c->cy, "samples", job->samples,
-                     "scene", job->scene ? job->scene : "studio", "views", views, "output_dir",
+                     "scene", job->scene ? job->scene : "studio", "shutter", job->shutter,
+                     "views", views, "output_dir",
                      job->out_dir, "info", info_path);
 }
 

@@ -11,6 +11,9 @@
 #     scene        "studio" (default: white light from everywhere, transparent background) or
 #                  "room" (the object stands on a textured floor inside a textured wall, opaque
 #                  RGB: what a photo of it in a room gives structure from motion to hold on to)
+#     shutter      > 0: the views are the consecutive frames of a video (the studio's phone):
+#                  the camera is keyframed at every view and Cycles blurs each frame over this
+#                  share of the frame interval (0.5: a 1/60 s shutter at 30 fps); 0: stills
 #     views        [{"file": NAME.png, "c2w": 16 numbers}], camera-to-world, row-major,
 #                  OpenGL axes (x right, y up, looking along -z), in the normalized object frame
 #                  (z up: Blender's own world axes; the glTF importer turns y-up into z-up)
@@ -183,7 +186,7 @@ def setup_scene():
     return scene, camera
 
 
-def textured_material(name, scale, colors):
+def textured_material(name, scale, colors, glow=0.0):
     """A procedural material that looks different everywhere (multi-scale noise over Voronoi
     cells, like stone): corners for SIFT at every scale, and none of the repetition of tiles
     or bricks, whose copies SIFT cannot tell apart."""
@@ -213,6 +216,9 @@ def textured_material(name, scale, colors):
     ramp.color_ramp.elements[1].color = colors[1]
     links.new(mix.outputs["Value"], ramp.inputs["Fac"])
     links.new(ramp.outputs["Color"], bsdf.inputs["Base Color"])
+    if glow > 0:  # a wall lit evenly from the room: little of the sky reaches it, and few
+        links.new(ramp.outputs["Color"], bsdf.inputs["Emission"])  # samples are noise there
+        bsdf.inputs["Emission Strength"].default_value = glow
     return mat
 
 
@@ -227,7 +233,7 @@ def add_room(scene, floor_z):
                                         location=(0, 0, floor_z + 8.0))
     wall = bpy.context.active_object
     wall.data.materials.append(textured_material(
-        "vf_wall", 0.8, [(0.25, 0.3, 0.4, 1), (0.9, 0.9, 0.85, 1)]))
+        "vf_wall", 0.8, [(0.25, 0.3, 0.4, 1), (0.9, 0.9, 0.85, 1)], glow=0.3))
     scene.render.film_transparent = False
     scene.render.image_settings.color_mode = "RGB"
     scene.cycles.max_bounces = 3  # diffuse walls: more bounces cost time, not features
@@ -248,12 +254,47 @@ with open(job["info"] + ".tmp", "w") as f:
     json.dump(info, f, indent=1)
 os.replace(job["info"] + ".tmp", job["info"])
 
+
+
+def matrix(c2w):
+    return mathutils.Matrix([c2w[0:4], c2w[4:8], c2w[8:12], c2w[12:16]])
+
+
+def keyframe_path(scene, camera, views, shutter):
+    """The camera moves through the views, one a frame, so that motion blur sees its motion.
+    The model stays as it is now (an animated model keeps its first frame)."""
+    for obj in scene.objects:
+        if obj is not camera and obj.animation_data:
+            obj.animation_data_clear()
+    camera.rotation_mode = "QUATERNION"
+    previous = None
+    for i, view in enumerate(views):
+        camera.matrix_world = matrix(view["c2w"])
+        q = camera.rotation_quaternion.copy()
+        if previous is not None and q.dot(previous) < 0:
+            q.negate()  # the same rotation; the one that interpolates the short way
+        camera.rotation_quaternion = q
+        previous = q
+        camera.keyframe_insert("location", frame=i + 1)
+        camera.keyframe_insert("rotation_quaternion", frame=i + 1)
+    for curve in camera.animation_data.action.fcurves:
+        for key in curve.keyframe_points:
+            key.interpolation = "LINEAR"
+    scene.render.use_motion_blur = True
+    scene.render.motion_blur_shutter = shutter
+
+
 views = job["views"]
+shutter = float(job.get("shutter", 0))
+if shutter > 0:
+    keyframe_path(scene, camera, views, shutter)
 for i, view in enumerate(views):
     out = os.path.join(job["output_dir"], view["file"])
     if not os.path.exists(out):
-        c2w = view["c2w"]
-        camera.matrix_world = mathutils.Matrix([c2w[0:4], c2w[4:8], c2w[8:12], c2w[12:16]])
+        if shutter > 0:
+            scene.frame_set(i + 1)
+        else:
+            camera.matrix_world = matrix(view["c2w"])
         partial = out + ".partial.png"
         scene.render.filepath = partial
         bpy.ops.render.render(write_still=True)

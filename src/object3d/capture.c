@@ -308,3 +308,35 @@ vf_status vf_object3d_render_images(const vf_object3d *obj, const vf_camera *cam
             vf_image_free(&images[i]);
     return status;
 }
+
+vf_status vf_object3d_render_video(const vf_object3d *obj, const vf_camera *cam,
+                                   const double *c2w, int n, double shutter, const char *dir,
+                                   const char *prefix, const char *progress_label,
+                                   vf_object3d_transform *fit)
+{
+    int given = obj->transform.scale > 0;
+    vf__blender_job job = {.model = obj->model,
+                           .transform = given ? &obj->transform : NULL,
+                           .camera = *cam,
+                           .samples = obj->samples,
+                           .scene = obj->scene,
+                           .shutter = shutter,
+                           .c2w = c2w,
+                           .count = n,
+                           .out_dir = dir,
+                           .prefix = prefix,
+                           .work_dir = dir,
+                           .label = progress_label};
+    json_t *measured = NULL;
+    vf_status status = vf__blender_render(&job, &measured);
+    if (status == VF_OK && fit) {
+        json_t *center = json_object_get(measured, "center");
+        for (int k = 0; k < 3; k++)
+            fit->center[k] = json_number_value(json_array_get(center, (size_t)k));
+        fit->scale = json_number_value(json_object_get(measured, "scale"));
+        if (!(fit->scale > 0) || json_array_size(center) != 3)
+            status = vf_fail(VF_EINTERNAL, "Blender's fit of %s has no transform", obj->model);
+    }
+    json_decref(measured);
+    return status;
+}

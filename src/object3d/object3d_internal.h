@@ -17,6 +17,8 @@ typedef struct vf__blender_job {
     vf_camera camera;
     int samples;
     const char *scene;     /* "studio" or "room" (blender_render.py) */
+    double shutter;        /* > 0: the views are video frames, blurred over this share of a
+                              frame's interval; 0: stills */
     const double *c2w;     /* count x 16, object frame, OpenGL axes */
     int count;
     const char *out_dir;   /* the PNGs */

@@ -1,0 +1,107 @@
+/* vf/studio.h: a simulated studio, a person with a phone around a 3D model.
+ *
+ * The physical loop (export, reshoot, score) needs a camera that moves and the truth of where
+ * it was. The studio films a textured 3D model (vf/object3d.h) standing on a textured floor in
+ * a room (Blender, Cycles) the way a person films an object with a phone, and writes what a
+ * phone writes: an H.264 video, portrait, stored sideways with a rotation flag. Beside it,
+ * VIDEO.truth.json holds the true camera of every frame. Nothing after the studio reads the
+ * truth: ingest, poses, train, attack, export, reshoot and score see only the video.
+ *
+ * What makes it a phone video and not a turntable (all seeded, sums of sines of random phase):
+ *   - the walk: one loop around the object a height, the heights joined by a smooth rise,
+ *     uneven pace, the distance breathing by a few per cent, the aim wandering around the
+ *     object's centre;
+ *   - the hand: position shake (~1% of the distance) and rotation tremor (~0.3 deg, up to
+ *     9 Hz), a slight roll;
+ *   - the camera: Cycles motion blur over the shutter (1/60 s at 30 fps), auto-exposure that
+ *     drifts (+-10%), sensor noise (shot and read noise on linear light), few samples a pixel
+ *     (Cycles' own noise adds to it), H.264 at CRF 20 through FFmpeg.
+ *
+ * The truth file: {"kind": "vfcapture studio truth", "model", "transform" {"center",
+ * "scale"} (the model's fit into the unit sphere, as vf_object3d_ingest records it),
+ * "camera" {"width", "height", "fx", "fy", "cx", "cy"} (the upright frames), "fps",
+ * "frames": [{"index", "time", "c2w"}] (16 numbers row-major, OpenGL axes, the model's
+ * object frame of vf/object3d.h: z up, object in the unit sphere)}; a re-shoot adds "target",
+ * "alignment" (the similarity from the model's frame to the workspace's) and per frame
+ * "c2w_workspace" and "viewpoint" (where the frame truly is in the workspace's terms).
+ *
+ * Work files (the rendered frames, Blender's log) are in VIDEO.studio/ and are removed when
+ * the video is written; an interrupted simulation continues from the frames already there. */
+#ifndef VF_STUDIO_H
+#define VF_STUDIO_H
+
+#include <jansson.h>
+#include <stdint.h>
+
+#include "vf/error.h"
+#include "vf/workspace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The phone and the way it is held, shared by both simulations. */
+typedef struct vf_studio_phone {
+    int width, height;     /* upright frame (default 360 x 640, portrait; a phone's 1080 x
+                              1920 costs 9x the render time) */
+    double fov_y;          /* vertical field of view, degrees (default 65: a phone's main
+                              camera held upright) */
+    double fps;            /* frames a second (default 30) */
+    double shutter;        /* open share of the frame interval (default 0.5) */
+    int samples;           /* Cycles samples a pixel (default 4; its noise is part of the
+                              sensor's) */
+    double shake;          /* scale of hand shake and tremor (default 1; 0: a tripod) */
+    double noise;          /* scale of sensor noise and exposure drift (default 1; 0: none) */
+    uint64_t seed;         /* every random choice (default 0) */
+} vf_studio_phone;
+
+typedef struct vf_studio_capture_options {
+    vf_studio_phone phone;
+    int loops;             /* loops around the object, one a height (default 2) */
+    double loop_seconds;   /* time a loop takes (default 8) */
+    double elevation_low;  /* degrees above the object's centre, first loop (default 12) */
+    double elevation_high; /* last loop (default 35) */
+    double distance;       /* camera distance, object radii (default 3.2: the object fills
+                              about two thirds of the portrait frame's width) */
+} vf_studio_capture_options;
+
+void vf_studio_capture_defaults(vf_studio_capture_options *o);
+
+/* Film the model (a .glb/.gltf/.obj/.blend file) into video (an .mp4 path) and write
+ * VIDEO.truth.json. *report (may be NULL) gets {"video", "truth", "frames", "seconds",
+ * "render_seconds", "width", "height"} (a new reference). Errors: those of
+ * vf_object3d_render_video, FFmpeg missing or failing; the video and the truth file appear
+ * only whole. */
+vf_status vf_studio_capture(const char *model, const vf_studio_capture_options *o,
+                            const char *video, json_t **report);
+
+typedef struct vf_studio_reshoot_options {
+    vf_studio_phone phone;        /* width/height/fov/fps 0: as the capture's truth file */
+    int target;                   /* exported target (0: v*) */
+    const char *truth;            /* the capture's truth file (NULL: beside the video the
+                                     workspace was ingested from) */
+    double walk_seconds;          /* from a natural viewpoint to the target (default 4) */
+    double hold_seconds;          /* filming around the target (default 6) */
+    double jitter;                /* how far around the target the person wanders, a share
+                                     of each viewpoint parameter's range (default 0.03) */
+} vf_studio_reshoot_options;
+
+void vf_studio_reshoot_defaults(vf_studio_reshoot_options *o);
+
+/* A person walks from the capture's first viewpoint to target o->target of the workspace's
+ * export and films around it, into video (+ VIDEO.truth.json). The workspace frame is
+ * related to the model's by a similarity fitted between the capture's true camera centres
+ * and the poses stage's (the person reads the target as the tool gives it, relative to the
+ * object). *report (may be NULL) gets {"video", "truth", "frames", "alignment" {"frames",
+ * "rotation_median_deg", "position_median"}} (a new reference). */
+vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
+                            const vf_studio_reshoot_options *o, const char *video,
+                            json_t **report);
+
+/* The truth file of a video: VIDEO with its extension replaced by ".truth.json". */
+vf_status vf_studio_truth_path(const char *video, char *out, size_t size);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

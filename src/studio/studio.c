@@ -1,0 +1,364 @@
+/* The studio's two simulations: a phone capture around the model, and a re-shoot at an
+ * exported target. */
+#define _GNU_SOURCE
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "studio_internal.h"
+#include "vf/attack_file.h"
+#include "vf/dataset.h"
+#include "vf/fsutil.h"
+#include "vf/ingest.h"
+#include "vf/json.h"
+#include "vf/log.h"
+#include "vf/object3d.h"
+#include "vf/targets.h"
+
+static void phone_defaults(vf_studio_phone *p)
+{
+    *p = (vf_studio_phone){.width = 360, .height = 640, .fov_y = 65, .fps = 30, .shutter = 0.5,
+                           .samples = 4, .shake = 1, .noise = 1, .seed = 0};
+}
+
+void vf_studio_capture_defaults(vf_studio_capture_options *o)
+{
+    memset(o, 0, sizeof *o);
+    phone_defaults(&o->phone);
+    o->loops = 2;
+    o->loop_seconds = 8;
+    o->elevation_low = 12;
+    o->elevation_high = 35;
+    o->distance = 3.2;
+}
+
+void vf_studio_reshoot_defaults(vf_studio_reshoot_options *o)
+{
+    memset(o, 0, sizeof *o);
+    phone_defaults(&o->phone);
+    o->phone.width = o->phone.height = 0; /* the capture's */
+    o->phone.fov_y = 0;
+    o->phone.fps = 0;
+    o->walk_seconds = 4;
+    o->hold_seconds = 6;
+    o->jitter = 0.03;
+}
+
+static vf_status check_phone(const vf_studio_phone *p)
+{
+    if (p->width < 16 || p->height < 16 || p->width > 8192 || p->height > 8192)
+        return vf_fail(VF_EINPUT, "frame size %dx%d is not one a phone films", p->width, p->height);
+    if (!(p->fov_y > 5 && p->fov_y < 170) || !(p->fps >= 1 && p->fps <= 240) ||
+        !(p->shutter >= 0 && p->shutter <= 1) || p->samples < 1 || !(p->shake >= 0) ||
+        !(p->noise >= 0))
+        return vf_fail(VF_EINPUT, "the phone's settings are out of range (field of view 5-170 "
+                                  "deg, 1-240 fps, shutter 0-1, samples >= 1)");
+    return VF_OK;
+}
+
+static vf_status model_record(const char *model, vf_object3d *obj)
+{
+    memset(obj, 0, sizeof *obj);
+    if (!vf_is_file(model))
+        return vf_fail(VF_EINPUT, "model %s does not exist", model);
+    if (!vf_object3d_is_model(model))
+        return vf_fail(VF_EINPUT, "%s is not a 3D model (give a .glb, .gltf, .obj or .blend file)",
+                       model);
+    if (!realpath(model, obj->model))
+        snprintf(obj->model, sizeof obj->model, "%s", model);
+    snprintf(obj->scene, sizeof obj->scene, "room");
+    return VF_OK;
+}
+
+vf_status vf_studio_capture(const char *model, const vf_studio_capture_options *o,
+                            const char *video, json_t **report)
+{
+    vf_object3d obj;
+    vf_status status = model_record(model, &obj);
+    if (status == VF_OK)
+        status = check_phone(&o->phone);
+    if (status == VF_OK && (o->loops < 1 || o->loops > 10 || !(o->loop_seconds > 0.5) ||
+                            !(o->distance > 1.2) || !(o->elevation_low > -10) ||
+                            !(o->elevation_high < 80)))
+        status = vf_fail(VF_EINPUT, "the walk's settings are out of range (1-10 loops, a loop "
+                                    "over 0.5 s, distance over 1.2 object radii, elevations "
+                                    "-10 to 80 deg)");
+    if (status != VF_OK)
+        return status;
+    obj.samples = o->phone.samples;
+    double *c2w = NULL;
+    int n = vf__capture_walk(o, &c2w);
+    if (n < 0)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    vf_info("filming %s: %d loops of %.0f s, %d frames %dx%d at %.0f fps", model, o->loops,
+            o->loop_seconds, n, o->phone.width, o->phone.height, o->phone.fps);
+    json_t *truth = json_pack(
+        "{s:s, s:s, s:s, s:{s:i, s:f, s:f, s:f, s:f, s:i, s:f, s:f, s:f, s:I}}", "kind",
+        "vfcapture studio truth", "simulation", "capture", "model", obj.model, "walk", "loops",
+        o->loops, "loop_seconds", o->loop_seconds, "elevation_low", o->elevation_low,
+        "elevation_high", o->elevation_high, "distance", o->distance, "samples", o->phone.samples,
+        "shutter", o->phone.shutter, "shake", o->phone.shake, "noise", o->phone.noise, "seed",
+        (json_int_t)o->phone.seed);
+    status = vf__film(&obj, &o->phone, c2w, n, NULL, video, truth, report);
+    free(c2w);
+    return status;
+}
+
+/* ---- the re-shoot ---- */
+
+typedef struct capture_truth {
+    json_t *doc;
+    vf_object3d obj;  /* model, transform, room */
+    vf_camera camera; /* the upright frames */
+    double fps;
+    int count;
+    double *c2w;      /* count x 16, model frame */
+} capture_truth;
+
+static void truth_free(capture_truth *t)
+{
+    json_decref(t->doc);
+    free(t->c2w);
+    memset(t, 0, sizeof *t);
+}
+
+static vf_status truth_load(const char *path, capture_truth *t)
+{
+    memset(t, 0, sizeof *t);
+    vf_status status = vf_json_load(path, &t->doc);
+    if (status != VF_OK)
+        return status;
+    const json_t *cam = json_object_get(t->doc, "camera");
+    const json_t *frames = json_object_get(t->doc, "frames");
+    const json_t *tr = json_object_get(t->doc, "transform");
+    const char *model = json_string_value(json_object_get(t->doc, "model"));
+    t->camera = (vf_camera){
+        .width = (int)json_integer_value(json_object_get(cam, "width")),
+        .height = (int)json_integer_value(json_object_get(cam, "height")),
+        .fx = json_number_value(json_object_get(cam, "fx")),
+        .fy = json_number_value(json_object_get(cam, "fy")),
+        .cx = json_number_value(json_object_get(cam, "cx")),
+        .cy = json_number_value(json_object_get(cam, "cy"))};
+    t->fps = json_number_value(json_object_get(t->doc, "fps"));
+    t->count = (int)json_array_size(frames);
+    double center[3];
+    int ok = model && t->camera.width > 0 && t->camera.fy > 0 && t->fps > 0 && t->count > 0 &&
+             vf_json_read_doubles(json_object_get(tr, "center"), center, 3) &&
+             json_number_value(json_object_get(tr, "scale")) > 0;
+    if (!ok)
+        return vf_fail(VF_EINPUT, "%s is not a studio truth file (camera, fps, model, transform "
+                                  "and frames expected)", path);
+    snprintf(t->obj.model, sizeof t->obj.model, "%s", model);
+    memcpy(t->obj.transform.center, center, sizeof center);
+    t->obj.transform.scale = json_number_value(json_object_get(tr, "scale"));
+    snprintf(t->obj.scene, sizeof t->obj.scene, "room");
+    t->c2w = malloc(sizeof(double) * 16 * (size_t)t->count);
+    if (!t->c2w)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    for (int i = 0; i < t->count; i++)
+        if (!vf_json_read_doubles(json_object_get(json_array_get(frames, (size_t)i), "c2w"),
+                                 t->c2w + 16 * i, 16))
+            return vf_fail(VF_EINPUT, "%s: frame %d has no c2w", path, i);
+    return VF_OK;
+}
+
+/* The similarity from the model's frame to the workspace's: the capture's true camera centres
+ * against the poses stage's, matched by the video frame each ingested image came from. */
+static vf_status align_workspace(const vf_workspace *ws, const capture_truth *t,
+                                 vf_similarity *s, json_t **report)
+{
+    char path[VF_PATH_MAX];
+    vf_dataset ds = {0};
+    vf_status status = vf_workspace_posed_frames(ws, path, sizeof path);
+    if (status == VF_OK)
+        status = vf_dataset_load(path, &ds);
+    if (status != VF_OK)
+        return status;
+    double *src = malloc(sizeof(double) * 3 * (size_t)(ds.count + 1));
+    double *dst = malloc(sizeof(double) * 3 * (size_t)(ds.count + 1));
+    const double **ours = malloc(sizeof *ours * (size_t)(ds.count + 1));
+    const double **ref = malloc(sizeof *ref * (size_t)(ds.count + 1));
+    int n = 0;
+    for (int i = 0; src && dst && ours && ref && i < ds.count; i++) {
+        const char *name = strrchr(ds.frames[i].image_path, '/');
+        int index;
+        if (sscanf(name ? name + 1 : ds.frames[i].image_path, "frame_%d", &index) != 1 ||
+            index < 0 || index >= t->count)
+            continue;
+        ours[n] = ds.frames[i].c2w;
+        ref[n] = t->c2w + 16 * index;
+        for (int k = 0; k < 3; k++) {
+            src[3 * n + k] = ref[n][4 * k + 3];
+            dst[3 * n + k] = ours[n][4 * k + 3];
+        }
+        n++;
+    }
+    if (!src || !dst || !ours || !ref)
+        status = vf_fail(VF_EINTERNAL, "out of memory");
+    else if (n < 3)
+        status = vf_fail(VF_EINPUT, "%s holds %d frames of the capture in the truth file (3 "
+                                    "needed): was the workspace ingested from that video?",
+                         path, n);
+    vf_pose_agreement agree = {0};
+    if (status == VF_OK)
+        status = vf_similarity_umeyama(src, dst, n, s);
+    if (status == VF_OK)
+        status = vf_pose_compare(ours, ref, n, 0, &agree);
+    if (status == VF_OK)
+        *report = json_pack("{s:i, s:f, s:f, s:f}", "frames", n, "scale", s->scale,
+                            "rotation_median_deg", agree.rot_median, "position_median",
+                            agree.pos_median);
+    free(src);
+    free(dst);
+    free(ours);
+    free(ref);
+    vf_dataset_free(&ds);
+    return status;
+}
+
+static vf_status truth_of_workspace(const vf_workspace *ws, const char *given, char *out,
+                                    size_t size)
+{
+    if (given) {
+        snprintf(out, size, "%s", given);
+    } else {
+        char kind[32], source[VF_PATH_MAX];
+        vf_ingest_source_kind(ws->root, kind, sizeof kind);
+        vf_ingest_source_path(ws->root, source, sizeof source);
+        if (strcmp(kind, "video") || !source[0])
+            return vf_fail(VF_EINPUT, "%s was not ingested from a video; give the capture's "
+                                      "truth file (--truth)", ws->root);
+        vf_status status = vf_studio_truth_path(source, out, size);
+        if (status != VF_OK)
+            return status;
+    }
+    if (!vf_is_file(out))
+        return vf_fail(VF_EINPUT, "no truth file %s: the studio re-shoots only what it filmed "
+                                  "(vfcapture simulate capture)", out);
+    return VF_OK;
+}
+
+static double smoothstep(double x)
+{
+    x = x < 0 ? 0 : x > 1 ? 1 : x;
+    return x * x * (3 - 2 * x);
+}
+
+vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
+                            const vf_studio_reshoot_options *o, const char *video,
+                            json_t **report)
+{
+    char truth_path[VF_PATH_MAX];
+    capture_truth t = {0};
+    vf_attack_file attack = {0};
+    vf_viewpoint target, start;
+    vf_similarity to_ws;
+    json_t *alignment = NULL;
+    vf_status status = truth_of_workspace(ws, o->truth, truth_path, sizeof truth_path);
+    if (status == VF_OK)
+        status = truth_load(truth_path, &t);
+    if (status == VF_OK && model) {
+        vf_object3d given;
+        status = model_record(model, &given);
+        if (status == VF_OK)
+            snprintf(t.obj.model, sizeof t.obj.model, "%s", given.model);
+    }
+    if (status == VF_OK)
+        status = vf_targets_workspace_target(ws->root, o->target, &target, NULL);
+    if (status == VF_OK)
+        status = vf_attack_file_load_workspace(ws, &attack);
+    if (status == VF_OK)
+        status = align_workspace(ws, &t, &to_ws, &alignment);
+    vf_studio_phone phone = o->phone;
+    if (status == VF_OK) {
+        if (!phone.width || !phone.height) {
+            phone.width = t.camera.width;
+            phone.height = t.camera.height;
+        }
+        if (!(phone.fov_y > 0))
+            phone.fov_y = 2 * atan(0.5 * t.camera.height / t.camera.fy) * 180 / M_PI;
+        if (!(phone.fps > 0))
+            phone.fps = t.fps;
+        status = check_phone(&phone);
+    }
+    if (status == VF_OK && (!(o->walk_seconds >= 0) || !(o->hold_seconds > 0) ||
+                            !(o->jitter >= 0 && o->jitter < 0.5)))
+        status = vf_fail(VF_EINPUT, "the walk's settings are out of range (walk >= 0 s, hold "
+                                    "> 0 s, jitter a share under 0.5)");
+    int n = (int)lround((o->walk_seconds + o->hold_seconds) * phone.fps);
+    double *c2w = status == VF_OK ? malloc(sizeof(double) * 16 * (size_t)n) : NULL;
+    json_t *extra = json_array();
+    if (status == VF_OK && !c2w)
+        status = vf_fail(VF_EINTERNAL, "out of memory");
+    if (status == VF_OK) {
+        /* the walk starts where the capture started, in the workspace's terms */
+        double first[16];
+        vf_similarity_apply_c2w(&to_ws, t.c2w, first);
+        vf_c2w_to_viewpoint(first, &start);
+        vf_similarity to_model = vf_similarity_inverse(&to_ws);
+        double distance = 0; /* the hand's scale: the capture's camera distance */
+        for (int i = 0; i < t.count; i++)
+            distance += sqrt(t.c2w[16 * i + 3] * t.c2w[16 * i + 3] +
+                             t.c2w[16 * i + 7] * t.c2w[16 * i + 7] +
+                             t.c2w[16 * i + 11] * t.c2w[16 * i + 11]) / t.count;
+        vf_rng rng;
+        vf_rng_seed(&rng, phone.seed + 1000);
+        studio_hand hand;
+        vf__hand_init(&hand, &rng, phone.shake, distance);
+        studio_wave wander[VF_VIEW_DIM];
+        for (int k = 0; k < VF_VIEW_DIM; k++)
+            vf__wave_init(&wander[k], &rng, 0.1, 0.6, o->jitter * attack.range[k]);
+        double a0[VF_VIEW_DIM], a1[VF_VIEW_DIM];
+        vf_viewpoint_to_array(&start, a0);
+        vf_viewpoint_to_array(&target, a1);
+        a1[0] = a0[0] + remainder(a1[0] - a0[0], 360.0); /* the short way round */
+        for (int i = 0; i < n; i++) {
+            double time = i / phone.fps, a[VF_VIEW_DIM];
+            double s = o->walk_seconds > 0 ? smoothstep(time / o->walk_seconds) : 1;
+            for (int k = 0; k < VF_VIEW_DIM; k++)
+                a[k] = a0[k] + s * (a1[k] - a0[k]) + s * vf__wave_at(&wander[k], time);
+            vf_viewpoint v = vf_viewpoint_from_array(a);
+            double steady_ws[16], steady[16], held[16], held_ws[16];
+            vf_viewpoint_to_c2w(&v, steady_ws);
+            vf_similarity_apply_c2w(&to_model, steady_ws, steady);
+            vf__hand_move(&hand, time, steady, c2w + 16 * i);
+            memcpy(held, c2w + 16 * i, sizeof held);
+            vf_similarity_apply_c2w(&to_ws, held, held_ws);
+            vf_viewpoint truly;
+            vf_c2w_to_viewpoint(held_ws, &truly);
+            double box;
+            vf_viewpoint_within(&truly, &target, attack.range, 1, &box);
+            json_array_append_new(extra, json_pack("{s:o, s:o, s:f}", "c2w_workspace",
+                                                   vf_json_doubles(held_ws, 16),
+                                                   "viewpoint", vf_viewpoint_json(&truly),
+                                                   "box_distance", box));
+        }
+    }
+    if (status == VF_OK) {
+        vf_info("re-shooting target %d of %s: %.0f s walk from the capture's first viewpoint, "
+                "%.0f s around the target, %d frames",
+                o->target, ws->root, o->walk_seconds, o->hold_seconds, n);
+        double m[16];
+        vf_similarity_to_mat4(&to_ws, m);
+        json_object_set_new(alignment, "model_to_workspace", vf_json_doubles(m, 16));
+        json_t *truth = json_pack(
+            "{s:s, s:s, s:s, s:s, s:s, s:i, s:o, s:O, s:{s:f, s:f, s:f, s:f, s:f, s:f, s:I}}",
+            "kind", "vfcapture studio truth", "simulation", "reshoot", "model", t.obj.model,
+            "capture_truth", truth_path, "workspace", ws->root, "target", o->target,
+            "target_viewpoint", vf_viewpoint_json(&target), "alignment", alignment, "walk",
+            "walk_seconds", o->walk_seconds, "hold_seconds", o->hold_seconds, "jitter",
+            o->jitter, "shutter", phone.shutter, "shake", phone.shake, "noise", phone.noise,
+            "seed", (json_int_t)phone.seed);
+        t.obj.samples = phone.samples;
+        status = vf__film(&t.obj, &phone, c2w, n, extra, video, truth, report);
+        if (status == VF_OK && report && *report)
+            json_object_set(*report, "alignment", alignment);
+    }
+    json_decref(alignment);
+    json_decref(extra);
+    free(c2w);
+    vf_attack_file_free(&attack);
+    truth_free(&t);
+    return status;
+}
