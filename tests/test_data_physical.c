@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "attack_helpers.h"
+#include "physical_helpers.h"
 #include "check.h"
 #include "poses_helpers.h"
 #include "vf/classifier.h"
@@ -450,23 +450,14 @@ static void check_export(const char *ws)
 /* `reshoot --video`: without smoothing, the frames saved are exactly score's kept frames. */
 static void check_reshoot(const char *ws, const char *video, int kept)
 {
-    char out[VF_PATH_MAX];
-    snprintf(out, sizeof out, "%s/reshoot.json", vf_test_tmpdir());
-    int rc = vf_test_system("'%s' reshoot '%s' --target 0 --video '%s' --tolerance %g "
-                            "--smoothing 1 --json >'%s' 2>/dev/null",
-                            tool(), ws, video, 100 * TOLERANCE, out);
-    CHECK(rc == 0, "reshoot exit %d", rc);
-    json_t *doc = load_json(out);
-    long long saved = json_integer_value(json_object_get(doc, "saved"));
-    json_t *first = json_array_get(json_object_get(doc, "advice"), 0);
-    const char *advice = json_string_value(json_object_get(first, "advice"));
-    printf("reshoot: %lld frames saved; first advice: %s\n", saved, advice ? advice : "?");
+    const char *advice;
+    long long saved = reshoot_video(tool(), ws, video, TOLERANCE, &advice);
+    printf("reshoot: %lld frames saved; first advice: %s\n", saved, advice);
     CHECK(saved == kept, "reshoot saved %lld frames, score kept %d", saved, kept);
-    CHECK(advice && strlen(advice) > 5, "advice given");
+    CHECK(strlen(advice) > 5, "advice given");
     char path[2 * VF_PATH_MAX];
     snprintf(path, sizeof path, "%s/reshoot_t00/frames/frame_00000.png", ws);
     CHECK(kept == 0 || vf_is_file(path), "%s saved", path);
-    json_decref(doc);
 }
 
 /* A capture that fails part-way (here a broken image after the video) keeps the frames already

@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "attack_helpers.h"
+#include "physical_helpers.h"
 #include "check.h"
 #include "poses_helpers.h"
 #include "vf/dataset.h"
@@ -172,17 +172,9 @@ static int check_score(const char *ws, const char *video, const json_t *truth)
 
 static void check_reshoot(const char *ws, const char *video, int kept)
 {
-    char out[VF_PATH_MAX];
-    snprintf(out, sizeof out, "%s/reshoot.json", vf_test_tmpdir());
-    int rc = vf_test_system("'%s' reshoot '%s' --target 0 --video '%s' --tolerance %g "
-                            "--smoothing 1 --json >'%s' 2>/dev/null",
-                            tool(), ws, video, 100 * TOLERANCE, out);
-    CHECK(rc == 0, "reshoot exit %d", rc);
-    json_t *doc = load_json(out);
-    long long saved = json_integer_value(json_object_get(doc, "saved"));
+    long long saved = reshoot_video(tool(), ws, video, TOLERANCE, NULL);
     printf("reshoot --video: %lld frames saved\n", saved);
     CHECK(saved == kept, "reshoot saved %lld frames, score kept %d", saved, kept);
-    json_decref(doc);
 }
 
 int main(int argc, char **argv)

@@ -271,23 +271,30 @@ vf_status vf_object3d_load(const vf_workspace *ws, vf_object3d *out)
     return status;
 }
 
+/* Blender's job for views of a recorded model, written beside the renders. */
+static vf__blender_job model_job(const vf_object3d *obj, const vf_camera *cam, const double *c2w,
+                                 int n, const char *dir, const char *prefix, const char *label)
+{
+    return (vf__blender_job){.model = obj->model,
+                             .transform = &obj->transform,
+                             .camera = *cam,
+                             .samples = obj->samples,
+                             .scene = obj->scene,
+                             .c2w = c2w,
+                             .count = n,
+                             .out_dir = dir,
+                             .prefix = prefix,
+                             .work_dir = dir,
+                             .label = label};
+}
+
 vf_status vf_object3d_render_images(const vf_object3d *obj, const vf_camera *cam,
                                     const double *c2w, int n, const char *dir,
                                     const char *prefix, const char *progress_label,
                                     vf_image *images)
 {
     static const float white[3] = {1, 1, 1};
-    vf__blender_job job = {.model = obj->model,
-                           .transform = &obj->transform,
-                           .camera = *cam,
-                           .samples = obj->samples,
-                           .scene = obj->scene,
-                           .c2w = c2w,
-                           .count = n,
-                           .out_dir = dir,
-                           .prefix = prefix,
-                           .work_dir = dir,
-                           .label = progress_label};
+    vf__blender_job job = model_job(obj, cam, c2w, n, dir, prefix, progress_label);
     vf_status status = vf__blender_render(&job, NULL);
     int loaded = 0;
     for (int i = 0; status == VF_OK && i < n; i++) {
@@ -314,19 +321,10 @@ vf_status vf_object3d_render_video(const vf_object3d *obj, const vf_camera *cam,
                                    const char *prefix, const char *progress_label,
                                    vf_object3d_transform *fit)
 {
-    int given = obj->transform.scale > 0;
-    vf__blender_job job = {.model = obj->model,
-                           .transform = given ? &obj->transform : NULL,
-                           .camera = *cam,
-                           .samples = obj->samples,
-                           .scene = obj->scene,
-                           .shutter = shutter,
-                           .c2w = c2w,
-                           .count = n,
-                           .out_dir = dir,
-                           .prefix = prefix,
-                           .work_dir = dir,
-                           .label = progress_label};
+    vf__blender_job job = model_job(obj, cam, c2w, n, dir, prefix, progress_label);
+    job.shutter = shutter;
+    if (!(obj->transform.scale > 0))
+        job.transform = NULL; /* fit it */
     json_t *measured = NULL;
     vf_status status = vf__blender_render(&job, &measured);
     if (status == VF_OK && fit) {

@@ -1,9 +1,10 @@
-/* tests/attack_helpers.h: an attack stage made by hand (header-only, static inline), for the
- * tests of the physical loop: v*, its label set and samples, committed as `vfcapture attack`
- * leaves it, so that export, reshoot and score run on a known v* without training a field.
- * Predictions are made up ("not fooled"): export only copies them. */
-#ifndef VF_TEST_ATTACK_HELPERS_H
-#define VF_TEST_ATTACK_HELPERS_H
+/* tests/physical_helpers.h: what the tests of the physical loop share (header-only, static
+ * inline). write_test_attack() makes an attack stage by hand: v*, its label set and samples,
+ * committed as `vfcapture attack` leaves it, so that export, reshoot and score run on a known
+ * v* without training a field (predictions are made up, "not fooled": export only copies
+ * them). reshoot_video() runs `vfcapture reshoot --video` and returns the frames it saved. */
+#ifndef VF_TEST_PHYSICAL_HELPERS_H
+#define VF_TEST_PHYSICAL_HELPERS_H
 
 #include <jansson.h>
 #include <stdio.h>
@@ -60,6 +61,31 @@ static inline void write_test_attack(const char *ws, const test_label_set *label
           "wrote %s", path);
     vf_workspace_close(&w);
     json_decref(doc);
+}
+
+/* `reshoot WS --target 0 --video VIDEO --smoothing 1` (no smoothing: the frames it saves are
+ * those score keeps); returns the number saved, -1 when it failed. *advice (may be NULL) gets
+ * the first frame's advice (static storage). */
+static inline long long reshoot_video(const char *tool, const char *ws, const char *video,
+                                      double tolerance, const char **advice)
+{
+    static char first[256];
+    char out[VF_PATH_MAX];
+    snprintf(out, sizeof out, "%s/reshoot.json", vf_test_tmpdir());
+    int rc = vf_test_system("'%s' reshoot '%s' --target 0 --video '%s' --tolerance %g "
+                            "--smoothing 1 --json >'%s' 2>/dev/null",
+                            tool, ws, video, 100 * tolerance, out);
+    CHECK(rc == 0, "reshoot exit %d", rc);
+    json_error_t e;
+    json_t *doc = json_load_file(out, 0, &e);
+    long long saved = rc == 0 && doc ? json_integer_value(json_object_get(doc, "saved")) : -1;
+    const char *text = json_string_value(
+        json_object_get(json_array_get(json_object_get(doc, "advice"), 0), "advice"));
+    snprintf(first, sizeof first, "%s", text ? text : "");
+    if (advice)
+        *advice = first;
+    json_decref(doc);
+    return saved;
 }
 
 #endif

@@ -1,0 +1,128 @@
+/* The simulated studio without Blender: the capture's walk (where the person goes, how the
+ * phone is held) and the errors that come before any rendering. test_data_studio films. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/studio/studio_internal.h"
+#include "check.h"
+#include "vf/fsutil.h"
+
+/* Distance of point p from the optical axis of c2w (OpenGL: looking along -z), and whether p
+ * is in front. */
+static double off_axis(const double c2w[16], const double p[3], int *in_front)
+{
+    double d[3] = {p[0] - c2w[3], p[1] - c2w[7], p[2] - c2w[11]};
+    double fwd[3] = {-c2w[2], -c2w[6], -c2w[10]};
+    double along = d[0] * fwd[0] + d[1] * fwd[1] + d[2] * fwd[2];
+    *in_front = along > 0;
+    double perp2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - along * along;
+    return sqrt(perp2 > 0 ? perp2 : 0);
+}
+
+static void test_walk(void)
+{
+    vf_studio_capture_options o;
+    vf_studio_capture_defaults(&o);
+    double *c2w = NULL;
+    int n = vf__capture_walk(&o, &c2w);
+    CHECK(n == 480, "2 loops of 8 s at 30 fps: %d frames", n);
+    static const double origin[3] = {0, 0, 0};
+    double worst_axis = 0, worst_step = 0, low = 0, high = 0, turned = 0;
+    double dmin = 1e9, dmax = 0;
+    int behind = 0;
+    for (int i = 0; i < n; i++) {
+        const double *m = c2w + 16 * i;
+        int front;
+        worst_axis = fmax(worst_axis, off_axis(m, origin, &front));
+        behind += !front;
+        double d = sqrt(m[3] * m[3] + m[7] * m[7] + m[11] * m[11]);
+        dmin = fmin(dmin, d), dmax = fmax(dmax, d);
+        double elevation = asin(m[11] / d) * 180 / M_PI;
+        if (i < n / 5)
+            low += elevation / (n / 5);
+        if (i >= n - n / 5)
+            high += elevation / (n / 5);
+        if (i > 0) {
+            const double *p = m - 16;
+            double r1[9], r2[9];
+            vf_mat4_rotation(m, r1);
+            vf_mat4_rotation(p, r2);
+            worst_step = fmax(worst_step, vf_rot_angle_deg(r1, r2));
+            turned += remainder(atan2(m[7], m[3]) - atan2(p[7], p[3]), 2 * M_PI);
+        }
+    }
+    printf("walk: optical axis within %.3f of the centre, distance %.2f-%.2f, elevation %.1f "
+           "then %.1f deg, %.0f deg around, largest turn between frames %.2f deg\n",
+           worst_axis, dmin, dmax, low, high, fabs(turned) * 180 / M_PI, worst_step);
+    CHECK(behind == 0, "the object is in front of every camera (%d behind)", behind);
+    CHECK(worst_axis < 0.4, "the object stays roughly centred: %.3f", worst_axis);
+    CHECK(dmin > 0.85 * o.distance && dmax < 1.15 * o.distance, "distance %.2f-%.2f", dmin, dmax);
+    CHECK(fabs(low - o.elevation_low) < 4 && fabs(high - o.elevation_high) < 4,
+          "one loop a height: %.1f and %.1f deg", low, high);
+    CHECK(fabs(fabs(turned) * 180 / M_PI - 720) < 45, "two loops: %.0f deg", turned * 180 / M_PI);
+    CHECK(worst_step > 0.3 && worst_step < 4, "a hand, not a jump: %.2f deg", worst_step);
+    free(c2w);
+
+    /* a tripod on the same path: aimed exactly at the centre, level */
+    o.phone.shake = 0;
+    n = vf__capture_walk(&o, &c2w);
+    double level = 0;
+    worst_axis = 0;
+    for (int i = 0; i < n; i++) {
+        int front;
+        worst_axis = fmax(worst_axis, off_axis(c2w + 16 * i, origin, &front));
+        level = fmax(level, fabs(c2w[16 * i + 8])); /* the camera's x axis, z component */
+    }
+    CHECK(worst_axis < 1e-6 && level < 1e-9, "no shake: centred (%g) and level (%g)", worst_axis,
+          level);
+    free(c2w);
+}
+
+static void test_truth_path(void)
+{
+    char out[VF_PATH_MAX];
+    CHECK(vf_studio_truth_path("a/b.mp4", out, sizeof out) == VF_OK &&
+              !strcmp(out, "a/b.truth.json"), "%s", out);
+    CHECK(vf_studio_truth_path("a.d/clip", out, sizeof out) == VF_OK &&
+              !strcmp(out, "a.d/clip.truth.json"), "%s", out);
+}
+
+/* Errors before Blender runs: one line, the input named, nothing written. */
+static void test_refusals(void)
+{
+    char video[VF_PATH_MAX], ws_dir[VF_PATH_MAX];
+    snprintf(video, sizeof video, "%s/out.mp4", vf_test_tmpdir());
+    vf_studio_capture_options o;
+    vf_studio_capture_defaults(&o);
+    vf_status s = vf_studio_capture("/nonexistent/model.glb", &o, video, NULL);
+    CHECK(s == VF_EINPUT && strstr(vf_error_message(), "/nonexistent/model.glb"), "%s",
+          vf_error_message());
+    s = vf_studio_capture(video, &o, video, NULL); /* not a model: it does not exist either */
+    CHECK(s == VF_EINPUT, "%s", vf_error_message());
+    o.loops = 0;
+    s = vf_studio_capture(vf_test_shared("data/models_3d/water_bottle__WaterBottle.glb"), &o,
+                          video, NULL);
+    CHECK(s == VF_EINPUT && strstr(vf_error_message(), "loops"), "%s", vf_error_message());
+    CHECK(!vf_is_file(video), "nothing written");
+
+    /* a re-shoot of a workspace that was not filmed by the studio */
+    snprintf(ws_dir, sizeof ws_dir, "%s/ws", vf_test_tmpdir());
+    vf_workspace ws;
+    CHECK(vf_workspace_open(ws_dir, 1, &ws) == VF_OK, "workspace");
+    vf_studio_reshoot_options r;
+    vf_studio_reshoot_defaults(&r);
+    s = vf_studio_reshoot(&ws, NULL, &r, video, NULL);
+    CHECK(s == VF_EINPUT && strstr(vf_error_message(), "--truth"), "%s", vf_error_message());
+    vf_workspace_close(&ws);
+    CHECK(!vf_is_file(video), "nothing written");
+}
+
+int main(int argc, char **argv)
+{
+    check_args(argc, argv);
+    CHECK_CASE(test_walk);
+    CHECK_CASE(test_truth_path);
+    CHECK_CASE(test_refusals);
+    return check_finish();
+}
