@@ -10,6 +10,7 @@
 static const char usage[] =
     "usage: vfcapture simulate capture MODEL -o VIDEO.mp4 [options]\n"
     "       vfcapture simulate reshoot WS --target N -o VIDEO.mp4 [--model MODEL] [options]\n"
+    "       vfcapture simulate check WS VIDEO.mp4\n"
     "\n"
     "A simulated studio for the physical loop. Blender films the 3D model standing on a\n"
     "textured floor in a room, the way a person films an object with a phone: handheld,\n"
@@ -20,6 +21,8 @@ static const char usage[] =
     "  capture   one loop around the object a height, the heights joined by a smooth rise\n"
     "  reshoot   walk from the capture's first viewpoint to target N of the workspace's export\n"
     "            and film around it (the workspace was ingested from a simulated capture)\n"
+    "  check     after 'vfcapture score WS VIDEO' on a re-shoot: score's localization and\n"
+    "            kept frames against the truth, and the physical success rate\n"
     "\n"
     "options:\n"
     "  -o, --output VIDEO     the video to write (.mp4)\n"
@@ -159,8 +162,6 @@ static vf_status parse_options(int argc, char **argv, simulate_options *opt)
                                         VF_OK)
             re->jitter /= 100;
     }
-    if (s == VF_OK && !opt->output)
-        s = vf_fail(VF_EINPUT, "say where the video goes (-o VIDEO.mp4)");
     return s;
 }
 
@@ -187,12 +188,46 @@ static void print_report(const simulate_options *opt, const json_t *r)
                100 * json_number_value(json_object_get(a, "position_median")));
 }
 
+static void print_check(const simulate_options *opt, const json_t *r)
+{
+    if (opt->flags.json) {
+        cli_print_json(json_incref((json_t *)r));
+        return;
+    }
+    const json_t *p = json_object_get(r, "physical");
+    printf("%s against its truth:\n", json_string_value(json_object_get(r, "video")));
+    printf("  localized %lld of %lld frames: rotation median %.2f deg, position median %.2f%% "
+           "of the distance\n",
+           json_integer_value(json_object_get(r, "localized")),
+           json_integer_value(json_object_get(r, "frames")),
+           json_number_value(json_object_get(r, "rotation_median_deg")),
+           100 * json_number_value(json_object_get(r, "position_median")));
+    printf("  tolerance box +-%.0f%%: %lld frames truly in it, score kept %lld; %lld agree with "
+           "the truth, %lld at the box's edge (%.0f%% agreement off the edge)\n",
+           100 * json_number_value(json_object_get(r, "tolerance")),
+           json_integer_value(json_object_get(r, "truly_in_box")),
+           json_integer_value(json_object_get(r, "kept")),
+           json_integer_value(json_object_get(r, "agree")),
+           json_integer_value(json_object_get(r, "at_box_edge")),
+           100 * json_number_value(json_object_get(r, "agreement")));
+    const json_t *ci = json_object_get(p, "interval95");
+    printf("  physical success rate %.0f%% (%lld of %lld kept frames misclassified; 95%% "
+           "interval %.0f%% to %.0f%%)\n",
+           100 * json_number_value(json_object_get(p, "asr")),
+           json_integer_value(json_object_get(p, "misclassified")),
+           json_integer_value(json_object_get(p, "frames")),
+           100 * json_number_value(json_array_get(ci, 0)),
+           100 * json_number_value(json_array_get(ci, 1)));
+}
+
 int cmd_simulate(int argc, char **argv)
 {
     simulate_options opt = {0};
     vf_status s = parse_options(argc, argv, &opt);
     const char *what = s == VF_OK && optind < argc ? argv[optind] : "";
     json_t *report = NULL;
+    if (s == VF_OK && strcmp(what, "check") && !opt.output)
+        s = vf_fail(VF_EINPUT, "say where the video goes (-o VIDEO.mp4)");
     if (s == VF_OK && !strcmp(what, "capture")) {
         if (optind + 2 != argc)
             s = vf_fail(VF_EINPUT, "give one 3D model (see vfcapture simulate --help)");
@@ -210,8 +245,25 @@ int cmd_simulate(int argc, char **argv)
             s = vf_studio_reshoot(&ws, opt.model, &opt.reshoot, opt.output, &report);
             vf_workspace_close(&ws);
         }
+    } else if (s == VF_OK && !strcmp(what, "check")) {
+        vf_workspace ws;
+        if (optind + 3 != argc)
+            s = vf_fail(VF_EINPUT, "give a workspace and a re-shoot video (see vfcapture "
+                                   "simulate --help)");
+        else if (!vf_is_dir(argv[optind + 1]))
+            s = vf_fail(VF_EINPUT, "workspace %s does not exist", argv[optind + 1]);
+        else if ((s = vf_workspace_open(argv[optind + 1], 0, &ws)) == VF_OK) {
+            s = vf_studio_check(&ws, argv[optind + 2], &report);
+            vf_workspace_close(&ws);
+        }
+        if (s == VF_OK) {
+            print_check(&opt, report);
+            json_decref(report);
+            return 0;
+        }
     } else if (s == VF_OK) {
-        s = vf_fail(VF_EINPUT, "say 'capture' or 'reshoot' (see vfcapture simulate --help)");
+        s = vf_fail(VF_EINPUT, "say 'capture', 'reshoot' or 'check' (see vfcapture simulate "
+                               "--help)");
     }
     if (s != VF_OK)
         return cli_fail("simulate", s);

@@ -12,7 +12,8 @@
  *   - each re-shoot frame's localization (score's viewpoint) against its true pose in the
  *     workspace's frame: the same limits;
  *   - score keeps exactly the frames whose true pose lies in the tolerance box (frames within
- *     localization noise of the box's edge aside, and few), and reshoot saves the same frames.
+ *     localization noise of the box's edge aside, and few), and reshoot saves the same frames;
+ *   - `simulate check` (the studio's own report of a re-shoot) counts the same.
  * Give a scratch folder as argv[1] to keep (and reuse) the video and the workspace. */
 #include <jansson.h>
 #include <math.h>
@@ -166,6 +167,22 @@ static int check_score(const char *ws, const char *video, const json_t *truth)
     CHECK(edge <= n / 4, "%d frames at the box's edge", edge); /* measured 11 of 60, 23 of 135 */
     free(rot);
     free(pos);
+    json_decref(doc);
+
+    /* `simulate check` tells the same story */
+    rc = vf_test_system("'%s' simulate check '%s' '%s' --json >'%s' 2>'%s'", tool(), ws, video,
+                        out, err);
+    doc = load_json(out);
+    CHECK(rc == 0 && doc, "simulate check exit %d", rc);
+    CHECK(json_integer_value(json_object_get(doc, "localized")) == localized &&
+              json_integer_value(json_object_get(doc, "kept")) == kept &&
+              json_integer_value(json_object_get(doc, "truly_in_box")) == truly_in &&
+              json_integer_value(json_object_get(doc, "at_box_edge")) == edge,
+          "simulate check: localized %lld, kept %lld, in the box %lld, at the edge %lld",
+          json_integer_value(json_object_get(doc, "localized")),
+          json_integer_value(json_object_get(doc, "kept")),
+          json_integer_value(json_object_get(doc, "truly_in_box")),
+          json_integer_value(json_object_get(doc, "at_box_edge")));
     json_decref(doc);
     return kept;
 }

@@ -98,6 +98,15 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
                             const vf_studio_reshoot_options *o, const char *video,
                             json_t **report);
 
+/* How a re-shoot fared, against its truth: WS/score/score.json (of `vfcapture score WS VIDEO`)
+ * frame by frame beside VIDEO.truth.json. *report gets {"frames", "localized",
+ * "rotation_median_deg", "position_median" (localization against the true pose, a share of
+ * the camera distance 4), "tolerance", "truly_in_box", "kept", "agree", "at_box_edge" (true
+ * box distance within 15% of the tolerance: localization noise decides those), "agreement"
+ * (agree / frames off the edge), "physical" (score's kept frames: frames, misclassified, asr,
+ * interval95), "natural"} (a new reference). */
+vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report);
+
 /* The truth file of a video: VIDEO with its extension replaced by ".truth.json". */
 vf_status vf_studio_truth_path(const char *video, char *out, size_t size);
 

@@ -1,6 +1,7 @@
 /* The studio's two simulations: a phone capture around the model, and a re-shoot at an
  * exported target. */
 #define _GNU_SOURCE
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -360,5 +361,125 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
     free(c2w);
     vf_attack_file_free(&attack);
     truth_free(&t);
+    return status;
+}
+
+/* ---- the re-shoot's score against its truth ---- */
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    if (n == 0)
+        return NAN;
+    qsort(v, (size_t)n, sizeof *v, compare_doubles);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static int same_file(const char *a, const char *b)
+{
+    char ra[PATH_MAX], rb[PATH_MAX];
+    return realpath(a, ra) && realpath(b, rb) && !strcmp(ra, rb);
+}
+
+vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
+{
+    char truth_path[VF_PATH_MAX], score_path[VF_PATH_MAX];
+    json_t *truth = NULL, *score = NULL;
+    vf_attack_file attack = {0};
+    vf_status status = vf_studio_truth_path(video, truth_path, sizeof truth_path);
+    if (status == VF_OK && !vf_is_file(truth_path))
+        status = vf_fail(VF_EINPUT, "no truth file %s: check a video of `vfcapture simulate "
+                                    "reshoot`", truth_path);
+    if (status == VF_OK)
+        status = vf_path_join(score_path, sizeof score_path, ws->root, "score/score.json");
+    if (status == VF_OK && !vf_is_file(score_path))
+        status = vf_fail(VF_EINPUT, "%s has no score yet: run 'vfcapture score %s %s' first",
+                         ws->root, ws->root, video);
+    if (status == VF_OK)
+        status = vf_json_load(truth_path, &truth);
+    if (status == VF_OK)
+        status = vf_json_load(score_path, &score);
+    if (status == VF_OK)
+        status = vf_attack_file_load_workspace(ws, &attack);
+    const json_t *frames = json_object_get(truth, "frames");
+    const json_t *rows = json_object_get(score, "frames_detail");
+    double center[VF_VIEW_DIM];
+    double tolerance = json_number_value(json_object_get(score, "tolerance_percent")) / 100;
+    if (status == VF_OK &&
+        (!vf_json_read_doubles(json_object_get(score, "center_viewpoint"), center, VF_VIEW_DIM) ||
+         !(tolerance > 0) || !json_is_array(rows) || !json_is_array(frames)))
+        status = vf_fail(VF_EINPUT, "%s or %s is not what the studio and score write",
+                         score_path, truth_path);
+    size_t n = json_array_size(rows);
+    double *rot = status == VF_OK ? malloc(sizeof(double) * (n + 1)) : NULL;
+    double *pos = status == VF_OK ? malloc(sizeof(double) * (n + 1)) : NULL;
+    if (status == VF_OK && (!rot || !pos))
+        status = vf_fail(VF_EINTERNAL, "out of memory");
+    int seen = 0, localized = 0, kept = 0, truly_in = 0, agree = 0, edge = 0;
+    vf_viewpoint c = vf_viewpoint_from_array(center);
+    for (size_t i = 0; status == VF_OK && i < n; i++) {
+        const json_t *row = json_array_get(rows, i);
+        const char *name = json_string_value(json_object_get(row, "frame"));
+        const char *hash = name ? strrchr(name, '#') : NULL;
+        double known[16], a[VF_VIEW_DIM];
+        char scored[VF_PATH_MAX];
+        snprintf(scored, sizeof scored, "%.*s", hash ? (int)(hash - name) : 0, hash ? name : "");
+        if (!same_file(scored, video))
+            continue; /* a frame of another video */
+        const json_t *f = json_array_get(frames, (size_t)atol(hash + 1));
+        if (!f || !vf_json_read_doubles(json_object_get(f, "c2w_workspace"), known, 16))
+            continue; /* not a frame of this video */
+        seen++;
+        vf_viewpoint truly;
+        vf_c2w_to_viewpoint(known, &truly);
+        double box;
+        int expect = vf_viewpoint_within(&truly, &c, attack.range, tolerance, &box);
+        const char *st = json_string_value(json_object_get(row, "status"));
+        int is_kept = st && !strcmp(st, "kept");
+        truly_in += expect;
+        kept += is_kept;
+        if (fabs(box - tolerance) < 0.15 * tolerance)
+            edge++; /* within localization noise of the box's edge */
+        else
+            agree += expect == is_kept;
+        if (vf_json_read_doubles(json_object_get(row, "viewpoint"), a, VF_VIEW_DIM)) {
+            double ours[16], r1[9], r2[9];
+            vf_viewpoint v = vf_viewpoint_from_array(a);
+            vf_viewpoint_to_c2w(&v, ours);
+            vf_mat4_rotation(ours, r1);
+            vf_mat4_rotation(known, r2);
+            rot[localized] = vf_rot_angle_deg(r1, r2);
+            pos[localized] = sqrt(pow(ours[3] - known[3], 2) + pow(ours[7] - known[7], 2) +
+                                  pow(ours[11] - known[11], 2)) / VF_CAMERA_DISTANCE;
+            localized++;
+        }
+    }
+    if (status == VF_OK && seen == 0)
+        status = vf_fail(VF_EINPUT, "%s scored no frame of %s: run 'vfcapture score %s %s'",
+                         ws->root, video, ws->root, video);
+    if (status == VF_OK && report) {
+        const json_t *k = json_object_get(score, "kept");
+        *report = json_pack(
+            "{s:s, s:s, s:i, s:i, s:f, s:f, s:f, s:i, s:i, s:i, s:i, s:f, s:{s:O, s:O, s:O, s:O}, "
+            "s:O}",
+            "video", video, "truth", truth_path, "frames", seen, "localized", localized,
+            "rotation_median_deg", median(rot, localized), "position_median",
+            median(pos, localized), "tolerance", tolerance, "truly_in_box", truly_in, "kept",
+            kept, "agree", agree, "at_box_edge", edge, "agreement",
+            seen - edge > 0 ? (double)agree / (seen - edge) : NAN, "physical", "frames",
+            json_object_get(k, "frames"), "misclassified", json_object_get(k, "misclassified"),
+            "asr", json_object_get(k, "asr"), "interval95", json_object_get(k, "interval95"),
+            "natural", json_object_get(score, "natural"));
+    }
+    free(rot);
+    free(pos);
+    vf_attack_file_free(&attack);
+    json_decref(truth);
+    json_decref(score);
     return status;
 }
