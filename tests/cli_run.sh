@@ -100,4 +100,16 @@ kill "$pid"; wait "$pid" 2>/dev/null  # TERM: a background job ignores INT
 expect 0 "--restart" -- "$tool" "${attack[@]}" --steps 2 --restart
 grep -q "discarding what an interrupted run left" "$tmp/err" && ok || bad "--restart says it discards the checkpoint: $(head -3 "$tmp/err")"
 
+# A checkpoint of an earlier field (trained again since, here touched) is not continued: the
+# search starts over on the new one (the old code continued a scene-mode attack on an
+# object-mode field).
+"$tool" "${attack[@]}" --quiet 2>/dev/null &
+pid=$!
+for _ in $(seq 600); do [ -f "$checkpoint" ] && break; sleep 0.2; done
+kill "$pid"; wait "$pid" 2>/dev/null  # TERM: a background job ignores INT
+touch -d "+1 minute" "$ws/train/model.vff"
+expect 0 "an earlier field's checkpoint" -- "$tool" "${attack[@]}" --json
+grep -q "ran on an earlier field: starting over" "$tmp/err" && ok || bad "starts over on a new field: $(grep -i continu "$tmp/err")"
+json_check "all 10 steps in the result" 'len(d["loss_per_step"]) == 10'
+
 cli_finish

@@ -1,8 +1,10 @@
 /* The attack stage (vf/attack.h): the flow its header describes, one function a step. */
+#define _GNU_SOURCE /* struct stat's st_mtim */
 #include "vf/attack.h"
 
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "attack_internal.h"
 #include "vf/attack_file.h"
@@ -226,14 +228,28 @@ static vf_status restrict_space(attack_run *run)
     return vf_attack_config_check(&run->cfg);
 }
 
+/* Which field the attack runs on: the train stage's file, by size and modification time (a
+ * field trained again, e.g. in object mode, is another field). */
+static json_t *field_identity(const attack_run *run)
+{
+    char path[VF_PATH_MAX];
+    struct stat st;
+    if (vf_workspace_path(run->ws, "train", VF_FIELD_FILE, path, sizeof path) != VF_OK ||
+        stat(path, &st) != 0)
+        return json_null();
+    return json_pack("{s:I, s:I, s:I}", "size", (json_int_t)st.st_size, "mtime",
+                     (json_int_t)st.st_mtim.tv_sec, "mtime_ns", (json_int_t)st.st_mtim.tv_nsec);
+}
+
 /* What a checkpoint must match to be resumed. */
 static json_t *setup_json(const attack_run *run)
 {
     json_t *labels = json_array();
     for (int i = 0; i < run->label_count; i++)
         json_array_append_new(labels, json_integer(run->labels[i]));
-    return json_pack("{s:s, s:o, s:o}", "model", run->model_path, "labels", labels, "config",
-                     vf_attack_config_to_json(&run->cfg));
+    return json_pack("{s:s, s:o, s:o, s:o}", "model", run->model_path, "labels", labels,
+                     "config", vf_attack_config_to_json(&run->cfg), "field",
+                     field_identity(run));
 }
 
 static vf_status save_checkpoint(const attack_run *run, const vf_attack_state *st)
@@ -262,8 +278,16 @@ static vf_status load_checkpoint(attack_run *run, vf_attack_state *st)
         return vf_attack_init(st, &run->cfg);
     if ((s = vf_json_load(path, &doc)) != VF_OK)
         return s;
-    json_t *setup = setup_json(run);
-    if (!json_equal(setup, json_object_get(doc, "setup")))
+    json_t *setup = setup_json(run), *before = json_object_get(doc, "setup");
+    if (!json_equal(json_object_get(setup, "field"), json_object_get(before, "field"))) {
+        /* the field was trained again since: the checkpoint's search is of another field */
+        vf_info("the interrupted attack in %s ran on an earlier field: starting over",
+                run->ws->root);
+        json_decref(setup);
+        json_decref(doc);
+        return vf_attack_init(st, &run->cfg);
+    }
+    if (!json_equal(setup, before))
         s = vf_fail(VF_EINPUT,
                     "the interrupted attack in %s used other settings (model, labels or "
                     "options): give the same to continue it, or --restart",
