@@ -203,12 +203,14 @@ static void print_check(const simulate_options *opt, const json_t *r)
            json_number_value(json_object_get(r, "rotation_median_deg")),
            100 * json_number_value(json_object_get(r, "position_median")));
     printf("  tolerance box +-%.0f%%: %lld frames truly in it, score kept %lld; %lld agree with "
-           "the truth, %lld at the box's edge (%.0f%% agreement off the edge)\n",
+           "the truth, %lld within localization noise (%.3f) of the box's edge (%.0f%% "
+           "agreement off the edge)\n",
            100 * json_number_value(json_object_get(r, "tolerance")),
            json_integer_value(json_object_get(r, "truly_in_box")),
            json_integer_value(json_object_get(r, "kept")),
            json_integer_value(json_object_get(r, "agree")),
            json_integer_value(json_object_get(r, "at_box_edge")),
+           json_number_value(json_object_get(r, "edge_band")),
            100 * json_number_value(json_object_get(r, "agreement")));
     const json_t *ci = json_object_get(p, "interval95");
     printf("  physical success rate %.0f%% (%lld of %lld kept frames misclassified; 95%% "

@@ -102,9 +102,11 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
  * frame by frame beside VIDEO.truth.json. *report gets {"frames", "localized",
  * "rotation_median_deg", "position_median" (localization against the true pose, a share of
  * the camera distance 4), "tolerance", "truly_in_box", "kept", "agree", "at_box_edge" (true
- * box distance within 15% of the tolerance: localization noise decides those), "agreement"
- * (agree / frames off the edge), "physical" (score's kept frames: frames, misclassified, asr,
- * interval95), "natural"} (a new reference). */
+ * box distance within "edge_band" of the tolerance: localization noise decides those; the
+ * band is the 90th percentile of how far localization moved the frames' box distances, at
+ * least a tenth of the tolerance), "agreement" (agree / frames off the edge), "physical"
+ * (score's kept frames: frames, misclassified, asr, interval95), "natural"} (a new
+ * reference). */
 vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report);
 
 /* The truth file of a video: VIDEO with its extension replaced by ".truth.json". */

@@ -416,10 +416,17 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
         status = vf_fail(VF_EINPUT, "%s or %s is not what the studio and score write",
                          score_path, truth_path);
     size_t n = json_array_size(rows);
-    double *rot = status == VF_OK ? malloc(sizeof(double) * (n + 1)) : NULL;
-    double *pos = status == VF_OK ? malloc(sizeof(double) * (n + 1)) : NULL;
-    if (status == VF_OK && (!rot || !pos))
-        status = vf_fail(VF_EINTERNAL, "out of memory");
+    /* per frame: localization errors, the true box distance, score's verdict, and how far
+     * localization moved the box distance (the noise that decides frames near the edge) */
+    double *rot = NULL, *pos = NULL, *box = NULL, *noise = NULL;
+    int *kept_flag = NULL;
+    if (status == VF_OK) {
+        rot = malloc(sizeof(double) * (n + 1)), pos = malloc(sizeof(double) * (n + 1));
+        box = malloc(sizeof(double) * (n + 1)), noise = malloc(sizeof(double) * (n + 1));
+        kept_flag = malloc(sizeof(int) * (n + 1));
+        if (!rot || !pos || !box || !noise || !kept_flag)
+            status = vf_fail(VF_EINTERNAL, "out of memory");
+    }
     int seen = 0, localized = 0, kept = 0, truly_in = 0, agree = 0, edge = 0;
     vf_viewpoint c = vf_viewpoint_from_array(center);
     for (size_t i = 0; status == VF_OK && i < n; i++) {
@@ -434,22 +441,18 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
         const json_t *f = json_array_get(frames, (size_t)atol(hash + 1));
         if (!f || !vf_json_read_doubles(json_object_get(f, "c2w_workspace"), known, 16))
             continue; /* not a frame of this video */
-        seen++;
         vf_viewpoint truly;
         vf_c2w_to_viewpoint(known, &truly);
-        double box;
-        int expect = vf_viewpoint_within(&truly, &c, attack.range, tolerance, &box);
+        truly_in += vf_viewpoint_within(&truly, &c, attack.range, tolerance, &box[seen]);
         const char *st = json_string_value(json_object_get(row, "status"));
-        int is_kept = st && !strcmp(st, "kept");
-        truly_in += expect;
-        kept += is_kept;
-        if (fabs(box - tolerance) < 0.15 * tolerance)
-            edge++; /* within localization noise of the box's edge */
-        else
-            agree += expect == is_kept;
+        kept_flag[seen] = st && !strcmp(st, "kept");
+        kept += kept_flag[seen];
+        seen++;
         if (vf_json_read_doubles(json_object_get(row, "viewpoint"), a, VF_VIEW_DIM)) {
-            double ours[16], r1[9], r2[9];
+            double ours[16], r1[9], r2[9], located;
             vf_viewpoint v = vf_viewpoint_from_array(a);
+            vf_viewpoint_within(&v, &c, attack.range, tolerance, &located);
+            noise[localized] = fabs(located - box[seen - 1]);
             vf_viewpoint_to_c2w(&v, ours);
             vf_mat4_rotation(ours, r1);
             vf_mat4_rotation(known, r2);
@@ -459,18 +462,30 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
             localized++;
         }
     }
+    /* the edge band: the 90th percentile of that noise (at least a tenth of the tolerance) */
+    double band = 0.1 * tolerance;
+    if (localized > 0) {
+        qsort(noise, (size_t)localized, sizeof *noise, compare_doubles);
+        band = fmax(band, noise[(int)(0.9 * (localized - 1) + 0.5)]);
+    }
+    for (int i = 0; i < seen; i++) {
+        if (fabs(box[i] - tolerance) < band)
+            edge++;
+        else
+            agree += (box[i] <= tolerance) == kept_flag[i];
+    }
     if (status == VF_OK && seen == 0)
         status = vf_fail(VF_EINPUT, "%s scored no frame of %s: run 'vfcapture score %s %s'",
                          ws->root, video, ws->root, video);
     if (status == VF_OK && report) {
         const json_t *k = json_object_get(score, "kept");
         *report = json_pack(
-            "{s:s, s:s, s:i, s:i, s:f, s:f, s:f, s:i, s:i, s:i, s:i, s:f, s:{s:O, s:O, s:O, s:O}, "
-            "s:O}",
+            "{s:s, s:s, s:i, s:i, s:f, s:f, s:f, s:i, s:i, s:i, s:i, s:f, s:f, "
+            "s:{s:O, s:O, s:O, s:O}, s:O}",
             "video", video, "truth", truth_path, "frames", seen, "localized", localized,
             "rotation_median_deg", median(rot, localized), "position_median",
             median(pos, localized), "tolerance", tolerance, "truly_in_box", truly_in, "kept",
-            kept, "agree", agree, "at_box_edge", edge, "agreement",
+            kept, "agree", agree, "at_box_edge", edge, "edge_band", band, "agreement",
             seen - edge > 0 ? (double)agree / (seen - edge) : NAN, "physical", "frames",
             json_object_get(k, "frames"), "misclassified", json_object_get(k, "misclassified"),
             "asr", json_object_get(k, "asr"), "interval95", json_object_get(k, "interval95"),
@@ -478,6 +493,9 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
     }
     free(rot);
     free(pos);
+    free(box);
+    free(noise);
+    free(kept_flag);
     vf_attack_file_free(&attack);
     json_decref(truth);
     json_decref(score);
