@@ -62,7 +62,9 @@ vf_status vf_poses_options_check(const vf_poses_options *o);
 /* Run the stage on an open workspace with an ingest. *summary gets {"registered", "total",
  * "models", "unregistered", "reprojection_error_px", "points", "matcher", "camera_model",
  * "cameras", "up_method", "center_method", "scale_to_object", "seconds" {per COLMAP step},
- * "check" {"verdict", "sampled", "registered", "rotation_median_deg", ...} or null, and
+ * "check" {"verdict", "sampled", "registered", "rotation_median_deg", ...} or null,
+ * "mapping" ("default", or "relaxed": a model that left out more than a tenth of the frames was
+ * mapped again admitting frames on 15 inliers, not 30, and registered more), and
  * "fallback_from" (the matcher first chosen) when "auto" fell back to all pairs}
  * (a new reference). */
 vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **summary);

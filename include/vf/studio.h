@@ -101,10 +101,12 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
 /* How a re-shoot fared, against its truth: WS/score/score.json (of `vfcapture score WS VIDEO`)
  * frame by frame beside VIDEO.truth.json. *report gets {"frames", "localized",
  * "rotation_median_deg", "position_median" (localization against the true pose, a share of
- * the camera distance 4), "tolerance", "truly_in_box", "kept", "agree", "at_box_edge" (true
+ * the camera distance 4), "tolerance", "truly_in_box", "kept"; of the localized frames,
+ * "agree" (score kept it exactly when its true pose is in the box) and "at_box_edge" (true
  * box distance within "edge_band" of the tolerance: localization noise decides those; the
  * band is the 90th percentile of how far localization moved the frames' box distances, at
- * least a tenth of the tolerance), "agreement" (agree / frames off the edge), "physical"
+ * least a tenth of the tolerance), "agreement" (agree / localized frames off the edge),
+ * "physical"
  * (score's kept frames: frames, misclassified, asr, interval95), "natural"} (a new
  * reference). */
 vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report);

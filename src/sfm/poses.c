@@ -350,6 +350,7 @@ static json_t *summarize(const poses_run *run, const vf_normalization *norm)
                           norm->up_method, "center_method", norm->center_method, "scale_to_object",
                           norm->object_from_world.scale, "seconds", run->seconds);
     json_object_set(j, "check", run->check ? run->check : json_null());
+    json_object_set_new(j, "mapping", json_string(run->relaxed ? "relaxed" : "default"));
     if (run->fallback) /* the matcher first chosen, whose model was not trusted */
         json_object_set_new(j, "fallback_from", json_string(run->fallback));
     return j;

@@ -115,8 +115,11 @@ vf_status vf__poses_match(poses_run *run)
                     &a);
 }
 
-/* Map into `output`; only the images named in image_list when it is not NULL. */
-static vf_status run_mapper(poses_run *run, const char *output, const char *image_list)
+/* Map into `output`; only the images named in image_list when it is not NULL. `relaxed`
+ * admits a frame on half the matches COLMAP asks by default (15 inliers, a 15% inlier
+ * ratio, not 30 and 25%): small or noisy frames whose matches are few but right. */
+static vf_status run_mapper(poses_run *run, const char *output, const char *image_list,
+                            int relaxed)
 {
     vf_args a = {0};
     vf_args_add(&a, "mapper");
@@ -125,6 +128,10 @@ static vf_status run_mapper(poses_run *run, const char *output, const char *imag
     vf_args_opt(&a, "--output_path", "%s", output);
     if (image_list)
         vf_args_opt(&a, "--image_list_path", "%s", image_list);
+    if (relaxed) {
+        vf_args_opt(&a, "--Mapper.abs_pose_min_num_inliers", "15");
+        vf_args_opt(&a, "--Mapper.abs_pose_min_inlier_ratio", "0.15");
+    }
     if (run->opt->has_intrinsics) {
         vf_args_opt(&a, "--Mapper.ba_refine_focal_length", "0");
         vf_args_opt(&a, "--Mapper.ba_refine_principal_point", "0");
@@ -132,6 +139,7 @@ static vf_status run_mapper(poses_run *run, const char *output, const char *imag
     }
     return run_step(run,
                     image_list ? "COLMAP: checking (registering the sample)"
+                    : relaxed  ? "COLMAP: registering frames again, on fewer matches"
                                : "COLMAP: registering frames",
                     &a);
 }
@@ -160,10 +168,11 @@ static int is_number(const char *name)
 }
 
 /* The models COLMAP wrote under sparse_dir (numbered folders), each converted to text under
- * text_root: the one with the most images (then points) in *best, its binary folder in
- * best_dir, how many there were in *count. None leaves *best empty. */
+ * text_root: the one with the most images (then points) in *best, its binary and text folders
+ * in best_dir and best_text, how many there were in *count. None leaves *best empty. */
 static vf_status load_largest_model(poses_run *run, const char *sparse_dir, const char *text_root,
-                                    vf_colmap_model *best, char best_dir[VF_PATH_MAX], int *count)
+                                    vf_colmap_model *best, char best_dir[VF_PATH_MAX],
+                                    char best_text[VF_PATH_MAX], int *count)
 {
     DIR *dir = opendir(sparse_dir);
     if (!dir)
@@ -190,6 +199,7 @@ static vf_status load_largest_model(poses_run *run, const char *sparse_dir, cons
             vf_colmap_model_free(best);
             *best = model;
             snprintf(best_dir, VF_PATH_MAX, "%s", bin);
+            snprintf(best_text, VF_PATH_MAX, "%s", txt);
         } else {
             vf_colmap_model_free(&model);
         }
@@ -200,30 +210,27 @@ static vf_status load_largest_model(poses_run *run, const char *sparse_dir, cons
 
 /* Move the chosen model's text files to stage/sparse (replacing those of an earlier mapping
  * of this run: the check's fallback maps again). */
-static vf_status keep_model_text(poses_run *run)
+static vf_status keep_model_text(poses_run *run, const char *text)
 {
-    char name[256], text[VF_PATH_MAX], from[VF_PATH_MAX], to[VF_PATH_MAX];
-    vf_path_basename(name, sizeof name, run->model_dir, 0);
-    vf_status status = vf_path_join(text, sizeof text, run->scratch, "text");
-    if (status == VF_OK)
-        status = vf_path_join(from, sizeof from, text, name);
-    if (status == VF_OK)
-        status = vf_path_join(to, sizeof to, run->stage.dir, "sparse");
+    char to[VF_PATH_MAX];
+    vf_status status = vf_path_join(to, sizeof to, run->stage.dir, "sparse");
     if (status == VF_OK)
         status = vf_remove_tree(to);
-    if (status == VF_OK && rename(from, to) != 0)
-        status = vf_fail(VF_EINTERNAL, "cannot move %s to %s: %s", from, to, strerror(errno));
+    if (status == VF_OK && rename(text, to) != 0)
+        status = vf_fail(VF_EINTERNAL, "cannot move %s to %s: %s", text, to, strerror(errno));
     return status;
 }
 
-vf_status vf__poses_map(poses_run *run)
+/* One mapping into scratch/<name> (binary models) and scratch/<name>_text, its largest model
+ * in *best (text folder in best_text), the count of models in *count. */
+static vf_status map_into(poses_run *run, const char *name, int relaxed, vf_colmap_model *best,
+                          char best_dir[VF_PATH_MAX], char best_text[VF_PATH_MAX], int *count)
 {
-    char sparse[VF_PATH_MAX], text[VF_PATH_MAX];
-    vf_colmap_model_free(&run->model); /* a second mapping (the check's fallback) starts over */
-    run->model_count = 0;
-    vf_status status = vf_path_join(sparse, sizeof sparse, run->scratch, "sparse");
+    char sparse[VF_PATH_MAX], text[VF_PATH_MAX], text_name[64];
+    snprintf(text_name, sizeof text_name, "%s_text", name);
+    vf_status status = vf_path_join(sparse, sizeof sparse, run->scratch, name);
     if (status == VF_OK)
-        status = vf_path_join(text, sizeof text, run->scratch, "text");
+        status = vf_path_join(text, sizeof text, run->scratch, text_name);
     if (status == VF_OK)
         status = vf_remove_tree(sparse);
     if (status == VF_OK)
@@ -234,12 +241,45 @@ vf_status vf__poses_map(poses_run *run)
         return status;
     /* The mapper exits 1 ("failed to create sparse model") when no pair of frames starts a
      * model: the input's fault, which the registration check reports (0 registered). */
-    status = run_mapper(run, sparse, NULL);
+    status = run_mapper(run, sparse, NULL, relaxed);
     if (status != VF_OK && run->colmap.last_exit != 1)
         return status;
-    status = load_largest_model(run, sparse, text, &run->model, run->model_dir, &run->model_count);
+    return load_largest_model(run, sparse, text, best, best_dir, best_text, count);
+}
+
+vf_status vf__poses_map(poses_run *run)
+{
+    char text[VF_PATH_MAX] = "";
+    vf_colmap_model_free(&run->model); /* a second mapping (the check's fallback) starts over */
+    run->model_count = 0;
+    run->relaxed = 0;
+    vf_status status =
+        map_into(run, "sparse", 0, &run->model, run->model_dir, text, &run->model_count);
+    /* A model that left out more than a tenth of the frames often grows when frames with few
+     * matches may join (a studio capture at 216x384: models of 21 and 40 of 50 frames, or one
+     * of 21, then all 50). */
+    if (status == VF_OK && 10 * run->model.image_count < 9 * run->frames.count) {
+        vf_colmap_model again = {0};
+        char again_dir[VF_PATH_MAX], again_text[VF_PATH_MAX];
+        int again_count = 0;
+        vf_info("%d of %d frames registered (the largest of %d model%s): mapping again, "
+                "admitting frames on fewer matches",
+                run->model.image_count, run->frames.count, run->model_count,
+                run->model_count == 1 ? "" : "s");
+        status = map_into(run, "sparse_relaxed", 1, &again, again_dir, again_text, &again_count);
+        if (status == VF_OK && again.image_count > run->model.image_count) {
+            vf_colmap_model_free(&run->model);
+            run->model = again;
+            run->model_count = again_count;
+            run->relaxed = 1;
+            snprintf(run->model_dir, sizeof run->model_dir, "%s", again_dir);
+            snprintf(text, sizeof text, "%s", again_text);
+        } else {
+            vf_colmap_model_free(&again);
+        }
+    }
     if (status == VF_OK && run->model.image_count > 0)
-        status = keep_model_text(run);
+        status = keep_model_text(run, text);
     return status;
 }
 
@@ -342,15 +382,15 @@ static vf_status check_model(poses_run *run, poses_check *out)
     vf_args_opt(&a, "--SiftMatching.use_gpu", "0");
     status = run_step(run, "COLMAP: checking (all pairs of a sample)", &a);
     if (status == VF_OK) {
-        status = run_mapper(run, sparse, list);
+        status = run_mapper(run, sparse, list, 0);
         if (status != VF_OK && run->colmap.last_exit == 1)
             return VF_OK; /* no model from the sample: inconclusive */
     }
     vf_colmap_model check = {0};
-    char check_dir[VF_PATH_MAX] = "";
+    char check_dir[VF_PATH_MAX] = "", check_text[VF_PATH_MAX] = "";
     int models = 0;
     if (status == VF_OK)
-        status = load_largest_model(run, sparse, text, &check, check_dir, &models);
+        status = load_largest_model(run, sparse, text, &check, check_dir, check_text, &models);
     if (status == VF_OK && check.image_count >= 3)
         status = compare_check(run, &check, out);
     vf_colmap_model_free(&check);

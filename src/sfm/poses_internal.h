@@ -41,6 +41,7 @@ typedef struct poses_run {
     vf_colmap_model model;      /* the largest model COLMAP made */
     char model_dir[VF_PATH_MAX]; /* its binary files */
     int model_count;
+    int relaxed;                /* the model is a second mapping's, on fewer matches */
     json_t *seconds;            /* wall time per step */
     int checking;               /* the registration check's steps are timed as "check" */
     json_t *check;              /* its result for the summary, or NULL (not run) */

@@ -419,12 +419,12 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
     /* per frame: localization errors, the true box distance, score's verdict, and how far
      * localization moved the box distance (the noise that decides frames near the edge) */
     double *rot = NULL, *pos = NULL, *box = NULL, *noise = NULL;
-    int *kept_flag = NULL;
+    int *kept_flag = NULL, *located_flag = NULL;
     if (status == VF_OK) {
         rot = malloc(sizeof(double) * (n + 1)), pos = malloc(sizeof(double) * (n + 1));
         box = malloc(sizeof(double) * (n + 1)), noise = malloc(sizeof(double) * (n + 1));
-        kept_flag = malloc(sizeof(int) * (n + 1));
-        if (!rot || !pos || !box || !noise || !kept_flag)
+        kept_flag = malloc(sizeof(int) * (n + 1)), located_flag = malloc(sizeof(int) * (n + 1));
+        if (!rot || !pos || !box || !noise || !kept_flag || !located_flag)
             status = vf_fail(VF_EINTERNAL, "out of memory");
     }
     int seen = 0, localized = 0, kept = 0, truly_in = 0, agree = 0, edge = 0;
@@ -447,8 +447,8 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
         const char *st = json_string_value(json_object_get(row, "status"));
         kept_flag[seen] = st && !strcmp(st, "kept");
         kept += kept_flag[seen];
-        seen++;
-        if (vf_json_read_doubles(json_object_get(row, "viewpoint"), a, VF_VIEW_DIM)) {
+        located_flag[seen] = vf_json_read_doubles(json_object_get(row, "viewpoint"), a, VF_VIEW_DIM);
+        if (located_flag[seen++]) {
             double ours[16], r1[9], r2[9], located;
             vf_viewpoint v = vf_viewpoint_from_array(a);
             vf_viewpoint_within(&v, &c, attack.range, tolerance, &located);
@@ -468,7 +468,9 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
         qsort(noise, (size_t)localized, sizeof *noise, compare_doubles);
         band = fmax(band, noise[(int)(0.9 * (localized - 1) + 0.5)]);
     }
-    for (int i = 0; i < seen; i++) {
+    for (int i = 0; i < seen; i++) { /* score's verdicts on the frames it localized */
+        if (!located_flag[i])
+            continue;
         if (fabs(box[i] - tolerance) < band)
             edge++;
         else
@@ -486,7 +488,7 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
             "rotation_median_deg", median(rot, localized), "position_median",
             median(pos, localized), "tolerance", tolerance, "truly_in_box", truly_in, "kept",
             kept, "agree", agree, "at_box_edge", edge, "edge_band", band, "agreement",
-            seen - edge > 0 ? (double)agree / (seen - edge) : NAN, "physical", "frames",
+            localized - edge > 0 ? (double)agree / (localized - edge) : NAN, "physical", "frames",
             json_object_get(k, "frames"), "misclassified", json_object_get(k, "misclassified"),
             "asr", json_object_get(k, "asr"), "interval95", json_object_get(k, "interval95"),
             "natural", json_object_get(score, "natural"));
@@ -496,6 +498,7 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
     free(box);
     free(noise);
     free(kept_flag);
+    free(located_flag);
     vf_attack_file_free(&attack);
     json_decref(truth);
     json_decref(score);
