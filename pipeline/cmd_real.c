@@ -1,5 +1,6 @@
 /* vfcapture real: the attack's viewpoints checked against the object itself (a workspace made
- * from a 3D model). The work is vf_real_run (vf/object3d.h); this parses and prints. */
+ * from a 3D model, or filmed by the studio). The work is vf_real_run (vf/object3d.h); this
+ * parses and prints. */
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -7,12 +8,14 @@
 #include "cli.h"
 #include "vf/object3d.h"
 #include "vf/resources.h"
+#include "vf/studio.h"
 
 static const char usage[] =
     "usage: vfcapture real WS [--model NAME|PATH] [--fluctuation-samples N] [--natural-views N]\n"
     "                         [--seed S] [--json]\n"
     "\n"
-    "For a workspace made from a 3D model (vfcapture ingest MODEL.glb), after attack: render\n"
+    "For a workspace made from a 3D model (vfcapture ingest MODEL.glb) or filmed by the studio\n"
+    "(vfcapture simulate capture: its truth file places the model), after attack: render\n"
     "the model itself with Blender, with the classifier's camera, at v*, at the attack's samples\n"
     "of p*(v), at fluctuation points around v* and at natural training views, and classify\n"
     "them beside the field's renders at the same cameras. Reports the paper's Real(v*) and\n"
@@ -124,7 +127,16 @@ int cmd_real(int argc, char **argv)
     if (s == VF_OK && !vf_is_dir(opt.workspace))
         s = vf_fail(VF_EINPUT, "workspace %s does not exist", opt.workspace);
     if (s == VF_OK && (s = vf_workspace_open(opt.workspace, 0, &ws)) == VF_OK) {
-        s = vf_real_run(&ws, &opt.real, &doc);
+        vf_object3d filmed_object;
+        vf_similarity to_object;
+        int filmed = 0;
+        s = vf_studio_object(&ws, &filmed_object, &to_object, &filmed);
+        if (filmed) {
+            opt.real.object = &filmed_object;
+            opt.real.to_object = &to_object;
+        }
+        if (s == VF_OK)
+            s = vf_real_run(&ws, &opt.real, &doc);
         vf_workspace_close(&ws);
     }
     if (s != VF_OK)

@@ -220,6 +220,17 @@ static void print_check(const simulate_options *opt, const json_t *r)
            json_integer_value(json_object_get(p, "frames")),
            100 * json_number_value(json_array_get(ci, 0)),
            100 * json_number_value(json_array_get(ci, 1)));
+    const json_t *real = json_object_get(r, "real");
+    if (json_is_object(real))
+        printf("  the object itself (vfcapture real): Real(v*) %.0f%%, Real(p*(v)) %.0f%%, "
+               "natural accuracy %.0f%%; physical minus Real(v*): %+.0f points\n",
+               100 * json_number_value(json_object_get(real, "asr_v_star")),
+               100 * json_number_value(json_object_get(real, "asr_samples")),
+               100 * json_number_value(json_object_get(real, "natural_accuracy")),
+               100 * (json_number_value(json_object_get(p, "asr")) -
+                      json_number_value(json_object_get(real, "asr_v_star"))));
+    else
+        printf("  (run 'vfcapture real WS' to put the object's own Real(v*) beside it)\n");
 }
 
 int cmd_simulate(int argc, char **argv)

@@ -13,7 +13,8 @@
  *     workspace's frame: the same limits;
  *   - score keeps exactly the frames whose true pose lies in the tolerance box (frames within
  *     localization noise of the box's edge aside, and few: `simulate check` measures that
- *     noise in box units), and reshoot saves the same frames; `simulate check` counts the same.
+ *     noise in box units), and reshoot saves most of them (its smoothed pose must be in the
+ *     box too); `simulate check` counts the same.
  * Give a scratch folder as argv[1] to keep (and reuse) the video and the workspace. */
 #include <jansson.h>
 #include <math.h>
@@ -206,7 +207,10 @@ static void check_reshoot(const char *ws, const char *video, int kept)
 {
     long long saved = reshoot_video(tool(), ws, video, TOLERANCE, NULL);
     printf("reshoot --video: %lld frames saved\n", saved);
-    CHECK(saved == kept, "reshoot saved %lld frames, score kept %d", saved, kept);
+    /* reshoot saves a frame when its smoothed pose is in the box too (a steadier cue for the
+     * person): a subset of score's, most of it (the full loop at +-10%: 46 of 52) */
+    CHECK(saved <= kept && saved >= 0.75 * kept, "reshoot saved %lld frames, score kept %d",
+          saved, kept);
 }
 
 int main(int argc, char **argv)

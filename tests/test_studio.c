@@ -114,6 +114,13 @@ static void test_refusals(void)
     vf_studio_reshoot_defaults(&r);
     s = vf_studio_reshoot(&ws, NULL, &r, video, NULL);
     CHECK(s == VF_EINPUT && strstr(vf_error_message(), "--truth"), "%s", vf_error_message());
+    /* nor is it the studio's object (`real` then reads WS/ingest/object.json) */
+    vf_object3d obj;
+    vf_similarity to_object;
+    int filmed = -1;
+    s = vf_studio_object(&ws, &obj, &to_object, &filmed);
+    CHECK(s == VF_OK && filmed == 0, "not filmed by the studio: %d (%s)", filmed,
+          vf_error_message());
     vf_workspace_close(&ws);
     CHECK(!vf_is_file(video), "nothing written");
 }

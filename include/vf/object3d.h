@@ -29,6 +29,7 @@
 #include "vf/error.h"
 #include "vf/fsutil.h"
 #include "vf/image.h"
+#include "vf/pose.h"
 #include "vf/workspace.h"
 
 #ifdef __cplusplus
@@ -125,11 +126,17 @@ typedef struct vf_real_options {
     int fluctuation_samples; /* viewpoints a level r = 1..10 % (default 20, the paper's) */
     int natural_views;       /* training views checked, spread over them (default 100) */
     uint64_t seed;           /* the fluctuation boxes' draws (default 0) */
+    /* The object of a workspace not made from a model (a studio capture, vf_studio_object):
+     * the model and the similarity from the workspace's frame to the object's. NULL (the
+     * default): WS/ingest/object.json, whose frame is the workspace's. */
+    const vf_object3d *object;
+    const vf_similarity *to_object;
 } vf_real_options;
 
 void vf_real_defaults(vf_real_options *o);
 
-/* The stage `real` of a workspace made from a 3D model, after `attack`: render the model
+/* The stage `real` of a workspace made from a 3D model (or filmed by the studio, with
+ * o->object), after `attack`: render the model
  * itself with the classifier camera at v*, at the attack's samples of p*(v), at fluctuation
  * points around v* and at natural training views; classify them, and the field's renders at the
  * same cameras; write WS/real/real.json (both columns: Real(v*), Real(p*(v)), the fluctuation

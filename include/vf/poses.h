@@ -53,7 +53,8 @@ typedef struct vf_poses_options {
 void vf_poses_defaults(vf_poses_options *o);
 
 /* The matcher "auto" chooses for `frames` frames, in capture order (a video, a webcam) or not
- * (photos): "exhaustive", "sequential" or "retrieval". */
+ * (photos): "exhaustive" or "retrieval" ("sequential", neighbours only, never closes the loop
+ * of a walk around the object: only when asked). */
 const char *vf_poses_auto_matcher(int frames, int ordered);
 
 /* VF_EINPUT naming the option that cannot run. */

@@ -34,6 +34,8 @@
 #include <stdint.h>
 
 #include "vf/error.h"
+#include "vf/object3d.h"
+#include "vf/pose.h"
 #include "vf/workspace.h"
 
 #ifdef __cplusplus
@@ -106,10 +108,19 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
  * box distance within "edge_band" of the tolerance: localization noise decides those; the
  * band is the 90th percentile of how far localization moved the frames' box distances, at
  * least a tenth of the tolerance), "agreement" (agree / localized frames off the edge),
- * "physical"
- * (score's kept frames: frames, misclassified, asr, interval95), "natural"} (a new
- * reference). */
+ * "physical" (score's kept frames: frames, misclassified, asr, interval95), "natural", and
+ * "real" (the object's own natural_accuracy, asr_v_star, asr_samples from WS/real/real.json,
+ * or null before `vfcapture real`)} (a new reference). */
 vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report);
+
+/* The object a workspace was filmed around, when the studio filmed it (ingested from a video
+ * beside its truth file): the model (room scene, VF_STUDIO_REAL_SAMPLES a pixel) and the
+ * similarity from the workspace's frame to the model's, fitted on the truth's camera centres
+ * against the poses stage's. For `vfcapture real` (vf_real_options.object). *filmed = 0 (and
+ * VF_OK) when the workspace is not the studio's. */
+#define VF_STUDIO_REAL_SAMPLES 32
+vf_status vf_studio_object(const vf_workspace *ws, vf_object3d *obj, vf_similarity *to_object,
+                           int *filmed);
 
 /* The truth file of a video: VIDEO with its extension replaced by ".truth.json". */
 vf_status vf_studio_truth_path(const char *video, char *out, size_t size);

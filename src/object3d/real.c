@@ -38,7 +38,8 @@ typedef struct real_run {
     vf_camera cam;
     char classifier_path[VF_PATH_MAX];
     int n, first[G_COUNT + 1]; /* cameras of group g: first[g] .. first[g + 1] - 1 */
-    double *c2w;               /* n x 16 */
+    double *c2w;               /* n x 16, the workspace's frame (the field's) */
+    double *object_c2w;        /* the same cameras in the object's frame (Blender's) */
     double *views;             /* n x 6: the viewpoint of each camera */
     vf_view_prediction *field_pred, *real_pred;
     double *psnr;              /* field render against the object's render, dB */
@@ -55,7 +56,11 @@ void vf_real_defaults(vf_real_options *o)
 
 static vf_status open_inputs(real_run *r)
 {
-    vf_status s = vf_object3d_load(r->ws, &r->obj);
+    vf_status s = VF_OK;
+    if (r->o->object)
+        r->obj = *r->o->object;
+    else
+        s = vf_object3d_load(r->ws, &r->obj);
     if (s == VF_OK)
         s = vf_attack_file_load_workspace(r->ws, &r->af);
     if (s == VF_OK)
@@ -91,12 +96,14 @@ static vf_status make_cameras(real_run *r)
         r->first[g + 1] = r->first[g] + counts[g];
     r->n = r->first[G_COUNT];
     r->c2w = malloc((size_t)r->n * 16 * sizeof *r->c2w);
+    r->object_c2w = malloc((size_t)r->n * 16 * sizeof *r->object_c2w);
     r->views = malloc((size_t)r->n * 6 * sizeof *r->views);
     r->field_pred = calloc((size_t)r->n, sizeof *r->field_pred);
     r->real_pred = calloc((size_t)r->n, sizeof *r->real_pred);
     r->psnr = calloc((size_t)r->n, sizeof *r->psnr);
     r->images = calloc((size_t)r->n, sizeof *r->images);
-    if (!r->c2w || !r->views || !r->field_pred || !r->real_pred || !r->psnr || !r->images) {
+    if (!r->c2w || !r->object_c2w || !r->views || !r->field_pred || !r->real_pred || !r->psnr ||
+        !r->images) {
         vf_dataset_free(&ds);
         return vf_fail(VF_EINTERNAL, "out of memory");
     }
@@ -122,6 +129,9 @@ static vf_status make_cameras(real_run *r)
         vf_c2w_to_viewpoint(r->c2w + 16 * k, &v);
         vf_viewpoint_to_array(&v, r->views + 6 * k);
     }
+    vf_similarity to_object = r->o->to_object ? *r->o->to_object : vf_similarity_identity();
+    for (int i = 0; i < r->n; i++)
+        vf_similarity_apply_c2w(&to_object, r->c2w + 16 * i, r->object_c2w + 16 * i);
     vf_dataset_free(&ds);
     return VF_OK;
 }
@@ -132,11 +142,12 @@ static vf_status prepare_renders(real_run *r, char *dir, size_t size)
 {
     json_t *poses = json_array();
     for (int i = 0; i < 16 * r->n; i++)
-        json_array_append_new(poses, json_real(r->c2w[i]));
-    json_t *request = json_pack("{s:s, s:i, s:i, s:f, s:f, s:f, s:f, s:i, s:o}", "model",
-                                r->obj.model, "width", r->cam.width, "height", r->cam.height,
-                                "fx", r->cam.fx, "fy", r->cam.fy, "cx", r->cam.cx, "cy",
-                                r->cam.cy, "samples", r->obj.samples, "c2w", poses);
+        json_array_append_new(poses, json_real(r->object_c2w[i]));
+    json_t *request = json_pack("{s:s, s:s, s:i, s:i, s:f, s:f, s:f, s:f, s:i, s:o}", "model",
+                                r->obj.model, "scene", r->obj.scene, "width", r->cam.width,
+                                "height", r->cam.height, "fx", r->cam.fx, "fy", r->cam.fy, "cx",
+                                r->cam.cx, "cy", r->cam.cy, "samples", r->obj.samples, "c2w",
+                                poses);
     static const char *const renders[] = {"renders", NULL};
     vf_status s = vf_path_join(dir, size, r->stage.dir, "renders");
     return s == VF_OK ? vf__keep_renders_for(r->stage.dir, request, renders) : s;
@@ -167,7 +178,7 @@ static vf_status classify_both(real_run *r)
         s = prepare_renders(r, dir, sizeof dir);
     double t1 = vf_now();
     if (s == VF_OK)
-        s = vf_object3d_render_images(&r->obj, &r->cam, r->c2w, r->n, dir, "view_",
+        s = vf_object3d_render_images(&r->obj, &r->cam, r->object_c2w, r->n, dir, "view_",
                                       "rendering the object", r->images);
     r->images_loaded = s == VF_OK;
     double t2 = vf_now();
@@ -336,6 +347,7 @@ static void release(real_run *r)
         vf_image_free(&r->images[i]);
     free(r->images);
     free(r->c2w);
+    free(r->object_c2w);
     free(r->views);
     free(r->field_pred);
     free(r->real_pred);

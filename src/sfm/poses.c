@@ -64,12 +64,17 @@ vf_status vf_poses_options_check(const vf_poses_options *o)
     return VF_OK;
 }
 
+/* Frames of a video (in capture order) beyond EXHAUSTIVE_MAX_FRAMES are matched by
+ * retrieval too, not with their neighbours: a walk around the object comes back to where it
+ * started, and neighbour matching never closes that loop. Measured on a studio capture of the
+ * water bottle (100 of 180 frames, 270x480, two loops; true poses known): sequential 64 s,
+ * 2.56 deg and 5.3% of the camera distance off (1.93 deg with SIMPLE_RADIAL); retrieval 160 s,
+ * 0.15 deg and 0.26%; all pairs 225 s, 0.16 deg. */
 const char *vf_poses_auto_matcher(int frames, int ordered)
 {
-    return frames <= EXHAUSTIVE_MAX_FRAMES   ? "exhaustive"
-           : ordered                         ? "sequential"
-           : frames <= EXHAUSTIVE_MAX_PHOTOS ? "exhaustive"
-                                             : "retrieval";
+    return frames <= EXHAUSTIVE_MAX_FRAMES                ? "exhaustive"
+           : !ordered && frames <= EXHAUSTIVE_MAX_PHOTOS ? "exhaustive"
+                                                          : "retrieval";
 }
 
 /* Fit the known intrinsics to the frames' size (a calibration at another resolution of the
@@ -109,7 +114,8 @@ static void choose_methods(poses_run *run, const char *source)
     run->matcher = strcmp(opt->matcher, "auto") ? opt->matcher : vf_poses_auto_matcher(n, ordered);
     const char *why = strcmp(opt->matcher, "auto") ? ""
                       : n <= EXHAUSTIVE_MAX_FRAMES ? " (few frames)"
-                      : ordered                    ? " (frames of a video, in capture order)"
+                      : ordered ? " (frames of a video: retrieval closes the loop around the "
+                                  "object, which neighbour matching does not)"
                                 : " (photos: file names say nothing about where they were taken)";
     if (!strcmp(run->matcher, "sequential"))
         vf_info("matching each frame with its next %d (and 2^k ahead)%s%s", opt->overlap,

@@ -240,6 +240,39 @@ static vf_status truth_of_workspace(const vf_workspace *ws, const char *given, c
     return VF_OK;
 }
 
+vf_status vf_studio_object(const vf_workspace *ws, vf_object3d *obj, vf_similarity *to_object,
+                           int *filmed)
+{
+    char kind[32], source[VF_PATH_MAX], truth_path[VF_PATH_MAX];
+    *filmed = 0;
+    vf_ingest_source_kind(ws->root, kind, sizeof kind);
+    vf_ingest_source_path(ws->root, source, sizeof source);
+    if (strcmp(kind, "video") || !source[0] ||
+        vf_studio_truth_path(source, truth_path, sizeof truth_path) != VF_OK ||
+        !vf_is_file(truth_path))
+        return VF_OK; /* not the studio's video */
+    capture_truth t = {0};
+    vf_similarity to_ws;
+    json_t *alignment = NULL;
+    vf_status status = truth_load(truth_path, &t);
+    if (status == VF_OK)
+        status = align_workspace(ws, &t, &to_ws, &alignment);
+    if (status == VF_OK) {
+        *obj = t.obj;
+        obj->samples = VF_STUDIO_REAL_SAMPLES;
+        *to_object = vf_similarity_inverse(&to_ws);
+        *filmed = 1;
+        vf_info("the object of %s: %s, filmed by the studio (%s; aligned on %lld frames, "
+                "%.2f deg median)",
+                ws->root, t.obj.model, truth_path,
+                json_integer_value(json_object_get(alignment, "frames")),
+                json_number_value(json_object_get(alignment, "rotation_median_deg")));
+    }
+    json_decref(alignment);
+    truth_free(&t);
+    return status;
+}
+
 static double smoothstep(double x)
 {
     x = x < 0 ? 0 : x > 1 ? 1 : x;
@@ -479,6 +512,10 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
     if (status == VF_OK && seen == 0)
         status = vf_fail(VF_EINPUT, "%s scored no frame of %s: run 'vfcapture score %s %s'",
                          ws->root, video, ws->root, video);
+    vf_real_rates real; /* the object's own side, when `vfcapture real` ran */
+    int real_found = 0;
+    if (status == VF_OK)
+        status = vf_real_load_rates(ws, &real, &real_found);
     if (status == VF_OK && report) {
         const json_t *k = json_object_get(score, "kept");
         *report = json_pack(
@@ -492,6 +529,12 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
             json_object_get(k, "frames"), "misclassified", json_object_get(k, "misclassified"),
             "asr", json_object_get(k, "asr"), "interval95", json_object_get(k, "interval95"),
             "natural", json_object_get(score, "natural"));
+        json_object_set_new(*report, "real",
+                            real_found ? json_pack("{s:f, s:f, s:f}", "natural_accuracy",
+                                                   real.natural_accuracy, "asr_v_star",
+                                                   real.asr_v_star, "asr_samples",
+                                                   real.asr_samples)
+                                       : json_null());
     }
     free(rot);
     free(pos);
