@@ -114,7 +114,8 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
 vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report);
 
 /* The object a workspace was filmed around, when the studio filmed it (ingested from a video
- * beside its truth file): the model (room scene, VF_STUDIO_REAL_SAMPLES a pixel) and the
+ * beside its truth file): the model (in the room, or on white when the field was trained in
+ * object mode, as the attack and score see it; VF_STUDIO_REAL_SAMPLES a pixel) and the
  * similarity from the workspace's frame to the model's, fitted on the truth's camera centres
  * against the poses stage's. For `vfcapture real` (vf_real_options.object). *filmed = 0 (and
  * VF_OK) when the workspace is not the studio's. */

@@ -260,13 +260,19 @@ vf_status vf_studio_object(const vf_workspace *ws, vf_object3d *obj, vf_similari
     if (status == VF_OK) {
         *obj = t.obj;
         obj->samples = VF_STUDIO_REAL_SAMPLES;
+        /* a field of the object alone is attacked, and score classifies the re-shoot's frames,
+         * on white: the object itself then too (the studio scene: white all around) */
+        const json_t *params = json_object_get(vf_workspace_stage_record(ws, "train"), "params");
+        if (json_is_true(json_object_get(params, "object_only")))
+            snprintf(obj->scene, sizeof obj->scene, "studio");
         *to_object = vf_similarity_inverse(&to_ws);
         *filmed = 1;
         vf_info("the object of %s: %s, filmed by the studio (%s; aligned on %lld frames, "
-                "%.2f deg median)",
+                "%.2f deg median), rendered %s",
                 ws->root, t.obj.model, truth_path,
                 json_integer_value(json_object_get(alignment, "frames")),
-                json_number_value(json_object_get(alignment, "rotation_median_deg")));
+                json_number_value(json_object_get(alignment, "rotation_median_deg")),
+                strcmp(obj->scene, "studio") ? "in the room" : "on white (object mode)");
     }
     json_decref(alignment);
     truth_free(&t);
