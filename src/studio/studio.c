@@ -218,22 +218,23 @@ static vf_status align_workspace(const vf_workspace *ws, const capture_truth *t,
     return status;
 }
 
+/* The truth file beside the video the workspace was ingested from; 0 when it was not a video. */
+static int truth_beside_video(const vf_workspace *ws, char *out, size_t size)
+{
+    char kind[32], source[VF_PATH_MAX];
+    vf_ingest_source_kind(ws->root, kind, sizeof kind);
+    vf_ingest_source_path(ws->root, source, sizeof source);
+    return !strcmp(kind, "video") && source[0] && vf_studio_truth_path(source, out, size) == VF_OK;
+}
+
 static vf_status truth_of_workspace(const vf_workspace *ws, const char *given, char *out,
                                     size_t size)
 {
-    if (given) {
+    if (given)
         snprintf(out, size, "%s", given);
-    } else {
-        char kind[32], source[VF_PATH_MAX];
-        vf_ingest_source_kind(ws->root, kind, sizeof kind);
-        vf_ingest_source_path(ws->root, source, sizeof source);
-        if (strcmp(kind, "video") || !source[0])
-            return vf_fail(VF_EINPUT, "%s was not ingested from a video; give the capture's "
-                                      "truth file (--truth)", ws->root);
-        vf_status status = vf_studio_truth_path(source, out, size);
-        if (status != VF_OK)
-            return status;
-    }
+    else if (!truth_beside_video(ws, out, size))
+        return vf_fail(VF_EINPUT, "%s was not ingested from a video; give the capture's truth "
+                                  "file (--truth)", ws->root);
     if (!vf_is_file(out))
         return vf_fail(VF_EINPUT, "no truth file %s: the studio re-shoots only what it filmed "
                                   "(vfcapture simulate capture)", out);
@@ -243,13 +244,9 @@ static vf_status truth_of_workspace(const vf_workspace *ws, const char *given, c
 vf_status vf_studio_object(const vf_workspace *ws, vf_object3d *obj, vf_similarity *to_object,
                            int *filmed)
 {
-    char kind[32], source[VF_PATH_MAX], truth_path[VF_PATH_MAX];
+    char truth_path[VF_PATH_MAX];
     *filmed = 0;
-    vf_ingest_source_kind(ws->root, kind, sizeof kind);
-    vf_ingest_source_path(ws->root, source, sizeof source);
-    if (strcmp(kind, "video") || !source[0] ||
-        vf_studio_truth_path(source, truth_path, sizeof truth_path) != VF_OK ||
-        !vf_is_file(truth_path))
+    if (!truth_beside_video(ws, truth_path, sizeof truth_path) || !vf_is_file(truth_path))
         return VF_OK; /* not the studio's video */
     capture_truth t = {0};
     vf_similarity to_ws;
@@ -486,7 +483,8 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
         const char *st = json_string_value(json_object_get(row, "status"));
         kept_flag[seen] = st && !strcmp(st, "kept");
         kept += kept_flag[seen];
-        located_flag[seen] = vf_json_read_doubles(json_object_get(row, "viewpoint"), a, VF_VIEW_DIM);
+        located_flag[seen] =
+            vf_json_read_doubles(json_object_get(row, "viewpoint"), a, VF_VIEW_DIM);
         if (located_flag[seen++]) {
             double ours[16], r1[9], r2[9], located;
             vf_viewpoint v = vf_viewpoint_from_array(a);
