@@ -1,6 +1,7 @@
 /* vfcapture simulate: the simulated studio (vf/studio.h). A person with a phone films a 3D
  * model in a room, or re-shoots it at an exported target; this parses and prints. */
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -47,12 +48,22 @@ static const char usage[] =
     "      --walk-seconds S   walking to the target (default 4)\n"
     "      --hold-seconds S   filming around it (default 6)\n"
     "      --jitter PERCENT   how far around the target the person wanders, per cent of each\n"
-    "                         parameter's range (default 3)\n" CLI_COMMON_HELP;
+    "                         parameter's range (default 3)\n"
+    "      --follow           closed loop: the person moves by the advice of 'vfcapture\n"
+    "                         reshoot', which reads the phone as a camera frame by frame;\n"
+    "                         reports per walk whether and when it reached the target and\n"
+    "                         whether the advice ever pointed the wrong way (10 fps unless\n"
+    "                         --fps; --hold-seconds: filming once on target, default 6)\n"
+    "      --starts N         follow: walks, from the capture's viewpoints (default 3)\n"
+    "      --give-up S        follow: a walk not on target by then ends (default 40)\n"
+    "      --tolerance PCT    follow: reshoot's box, per cent of each range (default 10)\n"
+    CLI_COMMON_HELP;
 
 enum {
     OPT_SIZE = CLI_OPT_FIRST_CUSTOM, OPT_FOV, OPT_FPS, OPT_SAMPLES, OPT_SHAKE, OPT_NOISE,
     OPT_SHUTTER, OPT_SEED, OPT_LOOPS, OPT_LOOP_SECONDS, OPT_ELEVATION, OPT_DISTANCE, OPT_TARGET,
-    OPT_MODEL, OPT_TRUTH, OPT_WALK, OPT_HOLD, OPT_JITTER
+    OPT_MODEL, OPT_TRUTH, OPT_WALK, OPT_HOLD, OPT_JITTER, OPT_FOLLOW, OPT_STARTS, OPT_GIVE_UP,
+    OPT_TOLERANCE
 };
 
 typedef struct simulate_options {
@@ -109,6 +120,10 @@ static vf_status parse_options(int argc, char **argv, simulate_options *opt)
         {"walk-seconds", required_argument, NULL, OPT_WALK},
         {"hold-seconds", required_argument, NULL, OPT_HOLD},
         {"jitter", required_argument, NULL, OPT_JITTER},
+        {"follow", no_argument, NULL, OPT_FOLLOW},
+        {"starts", required_argument, NULL, OPT_STARTS},
+        {"give-up", required_argument, NULL, OPT_GIVE_UP},
+        {"tolerance", required_argument, NULL, OPT_TOLERANCE},
         {0, 0, 0, 0},
     };
     vf_studio_capture_defaults(&opt->capture);
@@ -161,6 +176,15 @@ static vf_status parse_options(int argc, char **argv, simulate_options *opt)
         else if (c == OPT_JITTER && (s = cli_number("--jitter", optarg, 0, 49, &re->jitter)) ==
                                         VF_OK)
             re->jitter /= 100;
+        else if (c == OPT_FOLLOW)
+            re->follow = 1;
+        else if (c == OPT_STARTS)
+            s = cli_count_int("--starts", optarg, 1, 100, &re->starts);
+        else if (c == OPT_GIVE_UP)
+            s = cli_number("--give-up", optarg, 1, 3600, &re->give_up_seconds);
+        else if (c == OPT_TOLERANCE &&
+                 (s = cli_number("--tolerance", optarg, 0.1, 100, &re->tolerance)) == VF_OK)
+            re->tolerance /= 100;
     }
     return s;
 }
@@ -179,6 +203,27 @@ static void print_report(const simulate_options *opt, const json_t *r)
            json_number_value(json_object_get(r, "seconds")),
            json_number_value(json_object_get(r, "render_seconds")));
     printf("true camera poses: %s\n", json_string_value(json_object_get(r, "truth")));
+    const json_t *walks = json_object_get(r, "walks");
+    for (size_t i = 0; i < json_array_size(walks); i++) {
+        const json_t *w = json_array_get(walks, i);
+        const json_t *on = json_object_get(w, "seconds_to_on_target");
+        const json_t *in = json_object_get(w, "seconds_to_truly_in_box");
+        char when[96] = "reshoot never said on target";
+        if (json_is_number(on))
+            snprintf(when, sizeof when, "on target after %.1f s (truly in the box after %.1f s)",
+                     json_number_value(on), json_is_number(in) ? json_number_value(in) : NAN);
+        printf("walk %zu: %s, %s; %lld of the %lld frames called on target truly were; true "
+               "distance %.3f at the end (%.3f at the start, shares of the range); advice the "
+               "wrong way on %lld of %lld localized frames, at most %.1f s in a row\n",
+               i + 1, json_is_true(json_object_get(w, "reached")) ? "reached" : "NOT reached",
+               when, json_integer_value(json_object_get(w, "on_target_truly_in_box")),
+               json_integer_value(json_object_get(w, "on_target_frames")),
+               json_number_value(json_object_get(w, "final_box_distance")),
+               json_number_value(json_object_get(w, "from_box_distance")),
+               json_integer_value(json_object_get(w, "wrong_way_frames")),
+               json_integer_value(json_object_get(w, "localized")),
+               json_number_value(json_object_get(w, "wrong_way_longest_seconds")));
+    }
     const json_t *a = json_object_get(r, "alignment");
     if (a)
         printf("the workspace's poses against the truth (%lld frames): rotation median %.2f deg, "

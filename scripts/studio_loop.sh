@@ -2,13 +2,14 @@
 # The physical loop in the simulated studio, per object (the paper's Table 5, measured):
 # simulate capture -> vfcapture run (ingest, COLMAP, train, attack, export) -> simulate
 # reshoot at v* -> reshoot --video -> score -> real (Real(v*) on the model itself) ->
-# simulate check (localization and the physical success rate against the truth).
+# simulate check (localization and the physical success rate against the truth) -> the
+# closed loop (simulate reshoot --follow: three walks guided by reshoot's advice alone).
 #
 #   scripts/studio_loop.sh OUT_DIR [MODEL.glb ...]
 #
 # Default objects: the three recognised models of ../shared/data/models_3d that render
 # fastest (water bottle, bell pepper, folding chair). Settings are sized for 2 cores (15 to
-# 20 minutes an object measured): 270x480 at 15 fps with a 1/60 s shutter, two loops of 6 s; the
+# 20 minutes an object measured, and about 6 more for the closed loop): 270x480 at 15 fps with a 1/60 s shutter, two loops of 6 s; the
 # field in object mode for 3 minutes; the re-shoot 4 s walking and 6 s around v*; a scoring
 # box of +-10% (the re-shoot wanders 3% of each range around v*). Each object's lines go to
 # OUT_DIR/NAME/loop.log, its check to OUT_DIR/NAME/check.json. Rerunning continues: the
@@ -60,6 +61,9 @@ for model in "${models[@]}"; do
         "$tool" real "$dir/ws" --fluctuation-samples 5 --natural-views 30
         "$tool" simulate check "$dir/ws" "$dir/reshoot.mp4"
         "$tool" simulate check "$dir/ws" "$dir/reshoot.mp4" --json >"$dir/check.json"
+        [ -f "$dir/follow.mp4" ] ||
+            "$tool" simulate reshoot "$dir/ws" --target 0 --follow --starts 3 --give-up 30 \
+                --hold-seconds 2 --tolerance "$tolerance" -o "$dir/follow.mp4"
     } >>"$dir/loop.log" 2>&1 || echo "$name: failed (see $dir/loop.log)"
     echo "$name: $((SECONDS - start)) s" | tee -a "$dir/loop.log"
     grep -A8 "against its truth" "$dir/loop.log" | tail -n 8 || true

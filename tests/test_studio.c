@@ -7,6 +7,7 @@
 #include "../src/studio/studio_internal.h"
 #include "check.h"
 #include "vf/fsutil.h"
+#include "vf/targets.h"
 
 /* Distance of point p from the optical axis of c2w (OpenGL: looking along -z), and whether p
  * is in front. */
@@ -125,11 +126,44 @@ static void test_refusals(void)
     CHECK(!vf_is_file(video), "nothing written");
 }
 
+/* The closed loop's person reads reshoot's words back into the advice they came from. */
+static void test_read_advice(void)
+{
+    const vf_advice asked[3] = {{12, 0.5, -0.3, 4, -3, -7}, {-103, -0.2, 0.25, -5, 30, 9},
+                                {0.5, 0.01, 0.0, 1, 0, 0}};
+    for (int i = 0; i < 3; i++)
+        for (int cm = 0; cm < 2; cm++) {
+            double metres = cm ? 0.05 : 0; /* 5 cm a unit: distances in cm */
+            char text[384];
+            vf_advice_text(&asked[i], metres, 2.0, 0.08, text, sizeof text);
+            read_advice r = vf__read_advice(text, metres);
+            const vf_advice *a = &asked[i];
+            int big = fabs(a->orbit_deg) >= 2; /* the words leave out what is under 2 deg */
+            CHECK(r.given, "%s", text);
+            CHECK(fabs(r.orbit - (big ? a->orbit_deg : 0)) < 0.51, "orbit of '%s'", text);
+            CHECK(fabs(r.roll - (fabs(a->roll_deg) >= 2 ? a->roll_deg : 0)) < 0.51,
+                  "roll of '%s'", text);
+            CHECK(fabs(r.tilt - (fabs(a->tilt_deg) >= 2 ? a->tilt_deg : 0)) < 0.51,
+                  "tilt of '%s'", text);
+            CHECK(fabs(r.pan - (fabs(a->pan_deg) >= 2 ? a->pan_deg : 0)) < 0.51, "turn of '%s'",
+                  text);
+            double unit = cm ? 0.01 / metres : 0.006; /* what the words round to */
+            CHECK(fabs(r.raise - (fabs(a->raise) >= 0.08 ? a->raise : 0)) < unit,
+                  "raise of '%s'", text);
+            CHECK(fabs(r.back - (fabs(a->back) >= 0.08 ? a->back : 0)) < unit,
+                  "step of '%s'", text);
+        }
+    CHECK(!vf__read_advice(NULL, 0).given, "no advice");
+    read_advice still = vf__read_advice("hold still: on target", 0);
+    CHECK(still.given && still.orbit == 0 && still.raise == 0, "hold still");
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
     CHECK_CASE(test_walk);
     CHECK_CASE(test_truth_path);
     CHECK_CASE(test_refusals);
+    CHECK_CASE(test_read_advice);
     return check_finish();
 }

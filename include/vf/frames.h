@@ -2,7 +2,8 @@
  * calibration (calib intrinsics) and webcam ingest.
  *
  * The inputs are a list of image files, video files (anything FFmpeg decodes) and folders
- * (their images and videos, in name order), or one V4L2 webcam. Frames come out one at a time
+ * (their images and videos, in name order), or one V4L2 webcam, or a camera of the caller's
+ * own (vf_frame_source). Frames come out one at a time
  * as RGB, each with a name saying where it came from ("clip.mp4#12", "photos/0003.jpg").
  * A vf_frames is opened by vf_frames_open*(), closed by vf_frames_close(); frames handed out
  * are the caller's (vf_rgb8_free). */
@@ -19,6 +20,15 @@
 extern "C" {
 #endif
 
+/* A camera of the caller's own (an application embedding vfcapture; the simulated studio's
+ * phone): next() puts the next frame into *frame (reused) and sets *got, 0 when the camera is
+ * done. */
+typedef struct vf_frame_source {
+    vf_status (*next)(void *ctx, vf_rgb8 *frame, int *got);
+    void *ctx;
+    const char *name; /* what frame names say it is ("NAME#N") */
+} vf_frame_source;
+
 typedef struct vf_frames {
     /* The caller may set this after opening, before the first vf_frames_next. */
     int max_video_frames; /* at most this many frames of each video, spread evenly over it
@@ -34,7 +44,9 @@ typedef struct vf_frames {
     long video_stride;    /* frames from one handed out to the next */
     long video_given;     /* frames of it handed out */
     vf_v4l2 *camera;      /* webcam input, or NULL; vf_v4l2_get_info(camera) describes it */
-    char device[256];
+    char device[256];     /* the webcam's or the source's name */
+    const vf_frame_source *source; /* the caller's camera, or NULL */
+    long source_given;    /* its frames handed out */
 } vf_frames;
 
 typedef struct vf_frame_info {
@@ -51,6 +63,9 @@ vf_status vf_frames_open(char *const *args, int count, vf_frames *in);
  * request NULL: 1280x720, MJPEG or YUYV (see vf/v4l2.h). Errors as vf_v4l2_open's. */
 vf_status vf_frames_open_v4l2(const char *device, const vf_v4l2_ops *ops,
                               const vf_v4l2_request *request, vf_frames *in);
+
+/* The caller's own camera (kept by the caller until vf_frames_close). */
+void vf_frames_open_source(const vf_frame_source *source, vf_frames *in);
 
 /* The next frame into *frame (reused), *got = 0 at the end (a webcam never ends). A file that
  * cannot be read is an error naming it; a webcam silent for VF_CAMERA_TIMEOUT_MS is an

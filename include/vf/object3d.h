@@ -30,6 +30,7 @@
 #include "vf/fsutil.h"
 #include "vf/image.h"
 #include "vf/pose.h"
+#include "vf/rgb8.h"
 #include "vf/workspace.h"
 
 #ifdef __cplusplus
@@ -117,6 +118,25 @@ vf_status vf_object3d_render_video(const vf_object3d *obj, const vf_camera *cam,
                                    const double *c2w, int n, double shutter, const char *dir,
                                    const char *prefix, const char *progress_label,
                                    vf_object3d_transform *fit);
+
+/* ---- a live camera: one Blender kept open, rendering a view when asked ---- */
+
+/* For a camera that moves as its user decides from frame to frame (the studio's closed loop,
+ * vf/studio.h): Blender loads the model once and then renders one view a request, a fraction
+ * of a second each instead of its start-up of seconds. No motion blur. */
+typedef struct vf_object3d_live vf_object3d_live;
+
+/* Start Blender on obj (its recorded transform, scene and samples) with camera cam, renders and
+ * blender.log in dir; returns once the model is loaded. Errors as vf_object3d_render_video's. */
+vf_status vf_object3d_live_open(const vf_object3d *obj, const vf_camera *cam, const char *dir,
+                                vf_object3d_live **out);
+
+/* Render the view from c2w (object frame, OpenGL axes) into *frame (RGB, reused). A Blender
+ * that stopped or hangs (300 s) is an error naming its log. */
+vf_status vf_object3d_live_render(vf_object3d_live *live, const double c2w[16], vf_rgb8 *frame);
+
+/* Stop Blender and free; NULL is fine. */
+void vf_object3d_live_close(vf_object3d_live *live);
 
 /* ---- the real check: the adversarial viewpoints seen on the object itself ---- */
 

@@ -1,8 +1,9 @@
 /* vf/reshoot.h: the reshoot stage, guided capture at an exported target.
  *
- * Frames come from a webcam or a video file (vf/frames.h). Each is localized (vf/localize.h);
- * the pose is smoothed over time (vf_pose_smoother) so the advice does not jitter, compared
- * with the target, and turned into advice ("orbit 12 deg right, raise 5 cm", vf/targets.h).
+ * Frames come from a webcam, a video file or the caller's own camera (vf/frames.h). Each is
+ * localized (vf/localize.h); the pose is smoothed over time (vf_pose_smoother) so the advice
+ * does not jitter, compared with the target, and turned into advice ("orbit 12 deg right,
+ * raise 5 cm", vf/targets.h).
  * Frames whose raw and smoothed viewpoints both lie within the tolerance box of the target
  * are saved with their poses to WS/reshoot_tNN/frames/ (PNG, lossless) and poses.json
  * {"target", "target_viewpoint", "tolerance_percent", "frames": [{"file", "source",
@@ -19,6 +20,7 @@
 #include <jansson.h>
 
 #include "vf/error.h"
+#include "vf/frames.h"
 #include "vf/localize.h"
 #include "vf/workspace.h"
 
@@ -29,7 +31,9 @@ extern "C" {
 typedef struct vf_reshoot_options {
     int target;         /* exported target, 0 is v* (required: -1 is refused) */
     const char *device; /* a V4L2 webcam, or NULL */
-    const char *video;  /* or a video file (exactly one of the two) */
+    const char *video;  /* or a video file */
+    const vf_frame_source *camera; /* or a camera of the caller's own, which says when it is
+                                      done (vf/frames.h; exactly one of the three) */
     double tolerance;   /* box half-width, a share of each parameter's range (0.05) */
     double smoothing;   /* weight of the newest pose, (0, 1] (0.4) */
     double seconds;     /* webcam: stop after this long (60) */

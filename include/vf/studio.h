@@ -86,7 +86,18 @@ typedef struct vf_studio_reshoot_options {
     double hold_seconds;          /* filming around the target (default 6) */
     double jitter;                /* how far around the target the person wanders, a share
                                      of each viewpoint parameter's range (default 0.03) */
+    /* The closed loop (follow = 1): the person moves by the advice of `vfcapture reshoot`,
+     * which reads their phone as a camera, frame by frame; walk_seconds and jitter are then
+     * unused and hold_seconds is how long they film once reshoot says they are on target. */
+    int follow;
+    int starts;                   /* walks, from natural viewpoints of the capture (3) */
+    double give_up_seconds;       /* a walk that has not held the target by then ends (40) */
+    double tolerance;             /* reshoot's box, a share of each range (0.10) */
 } vf_studio_reshoot_options;
+
+/* The closed loop films at this rate unless told (every frame is rendered, localized and
+ * read in turn; a person's reactions need no more). */
+#define VF_STUDIO_FOLLOW_FPS 10
 
 void vf_studio_reshoot_defaults(vf_studio_reshoot_options *o);
 
@@ -99,6 +110,20 @@ void vf_studio_reshoot_defaults(vf_studio_reshoot_options *o);
 vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
                             const vf_studio_reshoot_options *o, const char *video,
                             json_t **report);
+
+/* With o->follow, the closed loop instead: o->starts walks, each from the capture's viewpoint
+ * at an evenly spread moment, the phone rendered live (vf_object3d_live) and read by
+ * vf_reshoot_run as a camera (vf_frame_source); the person reads its advice (the words, as
+ * the screen shows them) and moves by them after a reaction time, at a person's speeds. The
+ * video holds every walk's frames; its truth adds per frame "walk", "advice", "on_target" and
+ * "wrong_way" (the advice asked to orbit, raise or step opposite to what the truth needs), and
+ * "walks": [{"walk", "from", "from_box_distance", "frames", "localized", "reached" (reshoot
+ * said ON TARGET for the hold and most of those frames truly were in the box),
+ * "seconds_to_on_target" (reshoot's word), "seconds_to_truly_in_box", "on_target_frames",
+ * "on_target_truly_in_box", "final_box_distance", "wrong_way_frames",
+ * "wrong_way_longest_seconds"}]; *report gets {"video", "truth", "frames", "seconds", "walks",
+ * "reached", "alignment"}. WS/reshoot_tNN holds the last walk's frames on target. Not
+ * resumable: an interrupted closed loop starts over. */
 
 /* How a re-shoot fared, against its truth: WS/score/score.json (of `vfcapture score WS VIDEO`)
  * frame by frame beside VIDEO.truth.json. *report gets {"frames", "localized",

@@ -83,6 +83,13 @@ vf_status vf_frames_open_v4l2(const char *device, const vf_v4l2_ops *ops,
     return status;
 }
 
+void vf_frames_open_source(const vf_frame_source *source, vf_frames *in)
+{
+    memset(in, 0, sizeof *in);
+    snprintf(in->device, sizeof in->device, "%s", source->name ? source->name : "camera");
+    in->source = source;
+}
+
 /* The next frame of the video being read that is handed out (*got = 0 at its end or after
  * max_video_frames of it): the frames before it are skipped without decoding. */
 static vf_status read_video(vf_frames *in, vf_rgb8 *frame, int *got)
@@ -131,6 +138,12 @@ static void describe(vf_frame_info *info, const char *where, long index)
 vf_status vf_frames_next(vf_frames *in, vf_rgb8 *frame, vf_frame_info *info, int *got)
 {
     *got = 0;
+    if (in->source) {
+        vf_status status = in->source->next(in->source->ctx, frame, got);
+        if (status == VF_OK && *got)
+            describe(info, in->device, in->source_given++);
+        return status;
+    }
     if (in->camera) {
         uint32_t sequence = 0;
         vf_status status = vf_v4l2_read(in->camera, VF_CAMERA_TIMEOUT_MS, frame, &sequence);

@@ -255,7 +255,12 @@ static vf_status solve_pose(const vf_localizer *loc, const vf_camera *cam, frame
         return status;
     for (int round = 0; round < 2; round++) {
         int m = pack_inliers(w->xyz, w->uv, w->matches, w->inlier, w->pxyz, w->puv);
-        if (m < 3) {
+        /* OpenCV's RANSAC can hand back a pose of NaNs on a degenerate sample (a studio
+         * re-shoot frame of 20-odd inliers did): no pose, not a failed run */
+        int finite = 1;
+        for (int k = 0; k < 3; k++)
+            finite &= isfinite(rvec[k]) && isfinite(t[k]);
+        if (m < 3 || !finite) {
             *found = 0;
             return VF_OK;
         }

@@ -2,13 +2,19 @@
  * progress and its one-line errors. */
 #define _GNU_SOURCE
 #include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include "object3d_internal.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/process.h"
+#include "vf/rgb8.h"
 
 /* Exit codes of the script (its fail()): a problem of the input, of the installation. */
 #define SCRIPT_INPUT_ERROR 2
@@ -58,12 +64,13 @@ static json_t *job_json(const vf__blender_job *job, const char *info_path)
                               t->center[2], "scale", t->scale);
     }
     const vf_camera *c = &job->camera;
-    return json_pack("{s:s, s:o, s:i, s:i, s:f, s:f, s:f, s:f, s:i, s:s, s:f, s:o, s:s, s:s}", "model",
-                     job->model, "normalize", normalize, "width", c->width, "height", c->height,
-                     "fx", c->fx, "fy", c->fy, "cx", c->cx, "cy", c->cy, "samples", job->samples,
-                     "scene", job->scene ? job->scene : "studio", "shutter", job->shutter,
-                     "views", views, "output_dir",
-                     job->out_dir, "info", info_path);
+    return json_pack("{s:s, s:o, s:i, s:i, s:f, s:f, s:f, s:f, s:i, s:s, s:f, s:o, s:s, s:s, "
+                     "s:b}",
+                     "model", job->model, "normalize", normalize, "width", c->width, "height",
+                     c->height, "fx", c->fx, "fy", c->fy, "cx", c->cx, "cy", c->cy, "samples",
+                     job->samples, "scene", job->scene ? job->scene : "studio", "shutter",
+                     job->shutter, "views", views, "output_dir", job->out_dir, "info", info_path,
+                     "serve", job->serve);
 }
 
 /* What one run follows in Blender's output. */
@@ -111,14 +118,16 @@ static int count_missing(const vf__blender_job *job)
     return missing;
 }
 
-vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
+/* The script and the job file written into job->work_dir, Blender found, and its arguments
+ * (args, to free) and log path; a line saying how it was run appended to the log. */
+static vf_status prepare(const vf__blender_job *job, char program[VF_PATH_MAX],
+                         char info_path[VF_PATH_MAX], char log_path[VF_PATH_MAX], vf_args *args)
 {
-    char program[VF_PATH_MAX], script[VF_PATH_MAX], job_path[VF_PATH_MAX];
-    char info_path[VF_PATH_MAX], log_path[VF_PATH_MAX];
+    char script[VF_PATH_MAX], job_path[VF_PATH_MAX];
     vf_status status = vf_find_program("VF_BLENDER", "blender",
                                        "install it (apt-get install blender python3-numpy) or set "
                                        "VF_BLENDER to the blender program",
-                                       program, sizeof program);
+                                       program, VF_PATH_MAX);
     if (status == VF_OK)
         status = vf_mkdirs(job->out_dir);
     if (status == VF_OK)
@@ -126,9 +135,9 @@ vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
     if (status == VF_OK)
         status = vf_path_join(job_path, sizeof job_path, job->work_dir, "blender_job.json");
     if (status == VF_OK)
-        status = vf_path_join(info_path, sizeof info_path, job->work_dir, "blender_fit.json");
+        status = vf_path_join(info_path, VF_PATH_MAX, job->work_dir, "blender_fit.json");
     if (status == VF_OK)
-        status = vf_path_join(log_path, sizeof log_path, job->work_dir, "blender.log");
+        status = vf_path_join(log_path, VF_PATH_MAX, job->work_dir, "blender.log");
     if (status == VF_OK)
         status = write_text(script, vf__blender_script);
     json_t *doc = status == VF_OK ? job_json(job, info_path) : NULL;
@@ -142,19 +151,34 @@ vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
     if (!log)
         return vf_fail(VF_EINTERNAL, "cannot write %s: %s", log_path, strerror(errno));
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    vf_args args = {0};
-    vf_args_add(&args, "-b");
-    vf_args_add(&args, "--factory-startup");
-    vf_args_opt(&args, "-t", "%ld", cores > 0 ? cores : 1);
-    vf_args_opt(&args, "--python-exit-code", "%d", SCRIPT_UNCAUGHT);
-    vf_args_opt(&args, "--python", "%s", script);
-    vf_args_add(&args, "--");
-    vf_args_add(&args, job_path);
+    vf_args_add(args, "-b");
+    vf_args_add(args, "--factory-startup");
+    vf_args_opt(args, "-t", "%ld", cores > 0 ? cores : 1);
+    vf_args_opt(args, "--python-exit-code", "%d", SCRIPT_UNCAUGHT);
+    vf_args_opt(args, "--python", "%s", script);
+    vf_args_add(args, "--");
+    vf_args_add(args, job_path);
     fprintf(log, "\n$ %s", program);
-    for (int i = 0; i < args.count; i++)
-        fprintf(log, " %s", args.items[i]);
+    for (int i = 0; i < args->count; i++)
+        fprintf(log, " %s", args->items[i]);
     fprintf(log, "\n");
+    if (fclose(log) != 0)
+        return vf_fail(VF_EINTERNAL, "cannot write %s: %s", log_path, strerror(errno));
+    return VF_OK;
+}
 
+vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
+{
+    char program[VF_PATH_MAX], info_path[VF_PATH_MAX], log_path[VF_PATH_MAX];
+    vf_args args = {0};
+    vf_status status = prepare(job, program, info_path, log_path, &args);
+    FILE *log = status == VF_OK ? fopen(log_path, "a") : NULL;
+    if (status == VF_OK && !log)
+        status = vf_fail(VF_EINTERNAL, "cannot write %s: %s", log_path, strerror(errno));
+    if (status != VF_OK) {
+        vf_args_free(&args);
+        return status;
+    }
     follow f = {.shown = job->label != NULL};
     vf_progress_begin(&f.progress, job->label, (size_t)job->count, "views");
     int exit_code, sig;
@@ -187,4 +211,162 @@ vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
     if (fit && (status = vf_json_load(info_path, fit)) != VF_OK)
         return status;
     return VF_OK;
+}
+
+/* ---- a live camera: one Blender kept open, one view a request ---- */
+
+#define LIVE_LOAD_TIMEOUT_S 600  /* importing a large model */
+#define LIVE_RENDER_TIMEOUT_S 300
+
+struct vf_object3d_live {
+    int pid, channel;
+    char dir[VF_PATH_MAX], log_path[VF_PATH_MAX], model[VF_PATH_MAX];
+    long views;
+};
+
+/* The script's last "vf-error:" line in the log, or "". */
+static void last_error(const char *log_path, char *out, size_t size)
+{
+    FILE *fp = fopen(log_path, "r");
+    char line[1024];
+    out[0] = '\0';
+    while (fp && fgets(line, sizeof line, fp))
+        if (!strncmp(line, "vf-error: ", 10)) {
+            line[strcspn(line, "\n")] = '\0';
+            snprintf(out, size, "%.500s", line + 10);
+        }
+    if (fp)
+        fclose(fp);
+}
+
+static vf_status live_gone(vf_object3d_live *live, const char *doing)
+{
+    char why[512];
+    int code = vf_process_finish(live->pid, 2.0);
+    live->pid = -1;
+    last_error(live->log_path, why, sizeof why);
+    if (code == SCRIPT_INPUT_ERROR)
+        return vf_fail(VF_EINPUT, "%s", why);
+    return vf_fail(VF_EINTERNAL, "Blender stopped while %s %s (exit %d)%s%s; see %s", doing,
+                   live->model, code, why[0] ? ": " : "", why, live->log_path);
+}
+
+/* One line from Blender (without its newline), waiting at most timeout_s. */
+static vf_status live_read_line(vf_object3d_live *live, char *out, size_t size, int timeout_s,
+                                const char *doing)
+{
+    size_t used = 0;
+    for (;;) {
+        struct pollfd pfd = {.fd = live->channel, .events = POLLIN};
+        int ready = poll(&pfd, 1, timeout_s * 1000);
+        if (ready < 0 && errno == EINTR)
+            continue;
+        if (ready == 0)
+            return vf_fail(VF_EINTERNAL, "Blender did not answer in %d s while %s %s; see %s",
+                           timeout_s, doing, live->model, live->log_path);
+        char c;
+        ssize_t n = recv(live->channel, &c, 1, 0);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return live_gone(live, doing);
+        if (c == '\n')
+            break;
+        if (used + 1 < size)
+            out[used++] = c;
+    }
+    out[used] = '\0';
+    return VF_OK;
+}
+
+vf_status vf_object3d_live_open(const vf_object3d *obj, const vf_camera *cam, const char *dir,
+                                vf_object3d_live **out)
+{
+    *out = NULL;
+    if (!(obj->transform.scale > 0))
+        return vf_fail(VF_EINTERNAL, "a live camera needs the model's recorded transform");
+    vf_object3d_live *live = calloc(1, sizeof *live);
+    if (!live)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    live->pid = live->channel = -1;
+    snprintf(live->dir, sizeof live->dir, "%s", dir);
+    snprintf(live->model, sizeof live->model, "%s", obj->model);
+    vf__blender_job job = {.model = obj->model,
+                           .transform = &obj->transform,
+                           .camera = *cam,
+                           .samples = obj->samples,
+                           .scene = obj->scene,
+                           .out_dir = dir,
+                           .prefix = "live",
+                           .work_dir = dir,
+                           .serve = 1};
+    char program[VF_PATH_MAX], info_path[VF_PATH_MAX], line[512];
+    vf_args args = {0};
+    vf_status status = prepare(&job, program, info_path, live->log_path, &args);
+    int log_fd = status == VF_OK ? open(live->log_path, O_WRONLY | O_APPEND | O_CLOEXEC) : -1;
+    if (status == VF_OK && log_fd < 0)
+        status = vf_fail(VF_EINTERNAL, "cannot write %s: %s", live->log_path, strerror(errno));
+    if (status == VF_OK)
+        status = vf_process_start(program, &args, log_fd, &live->channel, &live->pid);
+    if (log_fd >= 0)
+        close(log_fd);
+    vf_args_free(&args);
+    if (status == VF_OK)
+        status = live_read_line(live, line, sizeof line, LIVE_LOAD_TIMEOUT_S, "loading");
+    if (status == VF_OK && strcmp(line, "ready") != 0)
+        status = vf_fail(VF_EINTERNAL, "Blender said '%s' instead of 'ready' loading %s", line,
+                         obj->model);
+    if (status != VF_OK) {
+        vf_object3d_live_close(live);
+        return status;
+    }
+    *out = live;
+    return VF_OK;
+}
+
+vf_status vf_object3d_live_render(vf_object3d_live *live, const double c2w[16], vf_rgb8 *frame)
+{
+    char file[64], path[VF_PATH_MAX], line[512];
+    if (live->pid < 0)
+        return vf_fail(VF_EINTERNAL, "the live camera on %s has stopped", live->model);
+    vf__blender_view_file("live", (int)(live->views++ % 1000), file, sizeof file);
+    json_t *request = json_pack("{s:o, s:s}", "c2w", vf_json_doubles(c2w, 16), "file", file);
+    char *text = request ? json_dumps(request, JSON_COMPACT) : NULL;
+    json_decref(request);
+    if (!text)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    size_t len = strlen(text);
+    text[len] = '\n'; /* json_dumps' terminator becomes the line's end */
+    vf_status status = VF_OK;
+    for (size_t sent = 0; status == VF_OK && sent < len + 1;) {
+        ssize_t n = send(live->channel, text + sent, len + 1 - sent, MSG_NOSIGNAL);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0)
+            status = live_gone(live, "rendering");
+        else
+            sent += (size_t)n;
+    }
+    free(text);
+    if (status == VF_OK)
+        status = live_read_line(live, line, sizeof line, LIVE_RENDER_TIMEOUT_S, "rendering");
+    if (status == VF_OK && strncmp(line, "done ", 5) != 0)
+        status = vf_fail(VF_EINTERNAL, "Blender could not render %s: %s", live->model,
+                         strncmp(line, "vf-error: ", 10) ? line : line + 10);
+    if (status == VF_OK)
+        status = vf_path_join(path, sizeof path, live->dir, file);
+    if (status == VF_OK)
+        status = vf_rgb8_load(path, frame);
+    return status;
+}
+
+void vf_object3d_live_close(vf_object3d_live *live)
+{
+    if (!live)
+        return;
+    if (live->channel >= 0)
+        close(live->channel); /* the script's loop ends with its socket */
+    if (live->pid >= 0)
+        vf_process_finish(live->pid, 10.0);
+    free(live);
 }

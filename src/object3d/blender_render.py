@@ -20,6 +20,8 @@
 #     output_dir   where the PNGs go (8 bit, sRGB; RGBA with a transparent background in the
 #                  studio)
 #     info         where to write what was measured: the transform, vertex and mesh counts
+#     serve        true: no views; render one view a request arriving on file descriptor 3
+#                  until it closes (serve() below: a camera that moves as the caller says)
 # It prints one "vf-view I N FILE" line a finished view and "vf-error: MESSAGE" before a
 # non-zero exit (2: the input is at fault, 4: the installation), so the C side can show
 # progress and one clear error line. Views whose PNG
@@ -284,6 +286,32 @@ def keyframe_path(scene, camera, views, shutter):
     scene.render.motion_blur_shutter = shutter
 
 
+def serve(scene, camera):
+    """A live camera (the studio's closed loop): the caller's requests arrive on the socket
+    that is file descriptor 3, one JSON line each, {"c2w": 16 numbers, "file": NAME.png};
+    each is rendered into output_dir and answered "done NAME.png" (or "vf-error: ..."). The
+    first line sent is "ready" (the model is loaded). The socket's end ends the loop."""
+    import socket
+    channel = socket.socket(fileno=3)
+    channel.sendall(b"ready\n")
+    for line in channel.makefile("r"):
+        try:
+            request = json.loads(line)
+            camera.matrix_world = matrix(request["c2w"])
+            name = os.path.basename(request["file"])
+        except (ValueError, KeyError, TypeError) as e:
+            channel.sendall(("vf-error: bad request: %s\n" % e).encode())
+            continue
+        out = os.path.join(job["output_dir"], name)
+        scene.render.filepath = out + ".partial.png"
+        bpy.ops.render.render(write_still=True)
+        os.replace(out + ".partial.png", out)
+        channel.sendall(("done %s\n" % name).encode())
+    os._exit(0)
+
+
+if job.get("serve"):
+    serve(scene, camera)
 views = job["views"]
 shutter = float(job.get("shutter", 0))
 if shutter > 0:

@@ -25,6 +25,7 @@ typedef struct vf__blender_job {
     const char *prefix;
     const char *work_dir;  /* the job file, the script, the fit and blender.log */
     const char *label;     /* progress line (NULL: none) */
+    int serve;             /* no views: a live camera (vf_object3d_live_open) */
 } vf__blender_job;
 
 /* Run Blender on the job and wait. *fit (may be NULL) gets what the script measured:

@@ -75,9 +75,14 @@ static vf_status handle_frame(reshoot_run *run, const vf_rgb8 *frame, const vf_f
                                             run->opt->tolerance, &box_smooth);
         vf_advice a;
         vf_advice_compute(smooth, run->target_c2w, &a);
-        /* Below these a person cannot act on the advice anyway. */
+        /* Steps below 2 deg or 2% of the distance are left out (too small to act on), but
+         * only inside the box: outside it the small steps are what is left to do, and "hold
+         * still" there would leave the person short of the target (the studio's closed loop:
+         * stopped at 0.15-0.25 of the range from a +-10% box with the coarse words alone). */
+        double fine = smooth_in ? 1 : 0.25;
         char text[384];
-        vf_advice_text(&a, run->metres, 2.0, 0.02 * VF_CAMERA_DISTANCE, text, sizeof text);
+        vf_advice_text(&a, run->metres, 2.0 * fine, 0.02 * fine * VF_CAMERA_DISTANCE, text,
+                       sizeof text);
         int keep = raw_in && smooth_in;
         if (keep && (status = save_frame(run, frame, info, &r, box_raw)) != VF_OK) {
             json_decref(entry);
@@ -108,8 +113,12 @@ static vf_status capture(reshoot_run *run)
 {
     vf_frames in;
     char *video = (char *)run->opt->video;
-    vf_status status = run->opt->device ? vf_frames_open_v4l2(run->opt->device, NULL, NULL, &in)
-                                        : vf_frames_open(&video, 1, &in);
+    vf_status status = VF_OK;
+    if (run->opt->camera)
+        vf_frames_open_source(run->opt->camera, &in);
+    else
+        status = run->opt->device ? vf_frames_open_v4l2(run->opt->device, NULL, NULL, &in)
+                                  : vf_frames_open(&video, 1, &in);
     if (status != VF_OK)
         return status;
     if (run->opt->device)
@@ -208,7 +217,7 @@ vf_status vf_reshoot_run(vf_workspace *ws, const vf_reshoot_options *o, vf_resho
     if (o->target < 0)
         status = vf_fail(VF_EINPUT, "say which target to shoot: --target N (0 is v*; see "
                                     "WS/export/targets.json)");
-    else if (!o->device == !o->video)
+    else if (!!o->device + !!o->video + !!o->camera != 1)
         status = vf_fail(VF_EINPUT, "give one source: --v4l2 /dev/videoN or --video FILE");
     else if (!(o->tolerance > 0 && o->tolerance <= 1) || !(o->smoothing > 0 && o->smoothing <= 1))
         status = vf_fail(VF_EINPUT, "tolerance and smoothing must be shares in (0, 1]");

@@ -33,7 +33,7 @@ static vf_status work_dir(const char *video, char *out, size_t size)
 
 /* What the phone's sensor does to frame i: a drifting auto-exposure gain on linear light, then
  * shot noise (grows with the light) and read noise, then sRGB again. */
-static void develop(vf_rgb8 *img, double gain, double noise, vf_rng *rng)
+void vf__develop(vf_rgb8 *img, double gain, double noise, vf_rng *rng)
 {
     static float linear[256];
     if (linear[255] == 0)
@@ -65,7 +65,7 @@ static vf_status run_ffmpeg(const char *program, vf_args *args, FILE *log, const
 
 /* The developed frames (upright PNGs in dir) as the phone stores them: turned counter-clockwise
  * to the sensor's landscape, with a display matrix saying "turn 90 degrees clockwise". */
-static vf_status encode(const char *dir, double fps, const char *video, const char *work)
+vf_status vf__encode(const char *dir, double fps, const char *video, const char *work)
 {
     char program[VF_PATH_MAX], pattern[VF_PATH_MAX], sideways[VF_PATH_MAX],
         partial[VF_PATH_MAX], log_path[VF_PATH_MAX];
@@ -189,13 +189,13 @@ vf_status vf__film(const vf_object3d *obj, const vf_studio_phone *phone, const d
             status = vf_rgb8_load(in, &img);
         if (status == VF_OK) {
             vf_rng_seed(&rng, phone->seed * 1000003ULL + (uint64_t)i);
-            develop(&img, exp(vf__wave_at(&exposure, i / phone->fps)), phone->noise, &rng);
+            vf__develop(&img, exp(vf__wave_at(&exposure, i / phone->fps)), phone->noise, &rng);
             status = vf_rgb8_save(out, &img);
         }
     }
     vf_rgb8_free(&img);
     if (status == VF_OK)
-        status = encode(film_dir, phone->fps, video, work);
+        status = vf__encode(film_dir, phone->fps, video, work);
 
     json_object_set_new(truth, "transform",
                         json_pack("{s:[f,f,f], s:f}", "center", fit.center[0], fit.center[1],

@@ -44,6 +44,9 @@ void vf_studio_reshoot_defaults(vf_studio_reshoot_options *o)
     o->walk_seconds = 4;
     o->hold_seconds = 6;
     o->jitter = 0.03;
+    o->starts = 3;
+    o->give_up_seconds = 40;
+    o->tolerance = 0.10;
 }
 
 static vf_status check_phone(const vf_studio_phone *p)
@@ -108,23 +111,14 @@ vf_status vf_studio_capture(const char *model, const vf_studio_capture_options *
 
 /* ---- the re-shoot ---- */
 
-typedef struct capture_truth {
-    json_t *doc;
-    vf_object3d obj;  /* model, transform, room */
-    vf_camera camera; /* the upright frames */
-    double fps;
-    int count;
-    double *c2w;      /* count x 16, model frame */
-} capture_truth;
-
-static void truth_free(capture_truth *t)
+void vf__truth_free(capture_truth *t)
 {
     json_decref(t->doc);
     free(t->c2w);
     memset(t, 0, sizeof *t);
 }
 
-static vf_status truth_load(const char *path, capture_truth *t)
+vf_status vf__truth_load(const char *path, capture_truth *t)
 {
     memset(t, 0, sizeof *t);
     vf_status status = vf_json_load(path, &t->doc);
@@ -164,9 +158,7 @@ static vf_status truth_load(const char *path, capture_truth *t)
     return VF_OK;
 }
 
-/* The similarity from the model's frame to the workspace's: the capture's true camera centres
- * against the poses stage's, matched by the video frame each ingested image came from. */
-static vf_status align_workspace(const vf_workspace *ws, const capture_truth *t,
+vf_status vf__align_workspace(const vf_workspace *ws, const capture_truth *t,
                                  vf_similarity *s, json_t **report)
 {
     char path[VF_PATH_MAX];
@@ -227,7 +219,7 @@ static int truth_beside_video(const vf_workspace *ws, char *out, size_t size)
     return !strcmp(kind, "video") && source[0] && vf_studio_truth_path(source, out, size) == VF_OK;
 }
 
-static vf_status truth_of_workspace(const vf_workspace *ws, const char *given, char *out,
+vf_status vf__truth_of_workspace(const vf_workspace *ws, const char *given, char *out,
                                     size_t size)
 {
     if (given)
@@ -251,9 +243,9 @@ vf_status vf_studio_object(const vf_workspace *ws, vf_object3d *obj, vf_similari
     capture_truth t = {0};
     vf_similarity to_ws;
     json_t *alignment = NULL;
-    vf_status status = truth_load(truth_path, &t);
+    vf_status status = vf__truth_load(truth_path, &t);
     if (status == VF_OK)
-        status = align_workspace(ws, &t, &to_ws, &alignment);
+        status = vf__align_workspace(ws, &t, &to_ws, &alignment);
     if (status == VF_OK) {
         *obj = t.obj;
         obj->samples = VF_STUDIO_REAL_SAMPLES;
@@ -272,7 +264,7 @@ vf_status vf_studio_object(const vf_workspace *ws, vf_object3d *obj, vf_similari
                 strcmp(obj->scene, "studio") ? "in the room" : "on white (object mode)");
     }
     json_decref(alignment);
-    truth_free(&t);
+    vf__truth_free(&t);
     return status;
 }
 
@@ -292,9 +284,9 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
     vf_viewpoint target, start;
     vf_similarity to_ws;
     json_t *alignment = NULL;
-    vf_status status = truth_of_workspace(ws, o->truth, truth_path, sizeof truth_path);
+    vf_status status = vf__truth_of_workspace(ws, o->truth, truth_path, sizeof truth_path);
     if (status == VF_OK)
-        status = truth_load(truth_path, &t);
+        status = vf__truth_load(truth_path, &t);
     if (status == VF_OK && model) {
         vf_object3d given;
         status = model_record(model, &given);
@@ -306,7 +298,7 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
     if (status == VF_OK)
         status = vf_attack_file_load_workspace(ws, &attack);
     if (status == VF_OK)
-        status = align_workspace(ws, &t, &to_ws, &alignment);
+        status = vf__align_workspace(ws, &t, &to_ws, &alignment);
     vf_studio_phone phone = o->phone;
     if (status == VF_OK) {
         if (!phone.width || !phone.height) {
@@ -316,13 +308,27 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
         if (!(phone.fov_y > 0))
             phone.fov_y = 2 * atan(0.5 * t.camera.height / t.camera.fy) * 180 / M_PI;
         if (!(phone.fps > 0))
-            phone.fps = t.fps;
+            phone.fps = o->follow ? VF_STUDIO_FOLLOW_FPS : t.fps;
         status = check_phone(&phone);
     }
     if (status == VF_OK && (!(o->walk_seconds >= 0) || !(o->hold_seconds > 0) ||
                             !(o->jitter >= 0 && o->jitter < 0.5)))
         status = vf_fail(VF_EINPUT, "the walk's settings are out of range (walk >= 0 s, hold "
                                     "> 0 s, jitter a share under 0.5)");
+    if (status == VF_OK && o->follow) {
+        if (o->starts < 1 || !(o->give_up_seconds > o->hold_seconds) ||
+            !(o->tolerance > 0 && o->tolerance <= 1))
+            status = vf_fail(VF_EINPUT, "the closed loop's settings are out of range (at least "
+                                        "one start, giving up later than the hold, tolerance "
+                                        "a share in (0, 1])");
+        else
+            status = vf__follow(ws, &t, &to_ws, &phone, o, video, truth_path, alignment,
+                                report);
+        json_decref(alignment);
+        vf_attack_file_free(&attack);
+        vf__truth_free(&t);
+        return status;
+    }
     int n = (int)lround((o->walk_seconds + o->hold_seconds) * phone.fps);
     double *c2w = status == VF_OK ? malloc(sizeof(double) * 16 * (size_t)n) : NULL;
     json_t *extra = json_array();
@@ -396,7 +402,7 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
     json_decref(extra);
     free(c2w);
     vf_attack_file_free(&attack);
-    truth_free(&t);
+    vf__truth_free(&t);
     return status;
 }
 

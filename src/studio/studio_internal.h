@@ -4,6 +4,8 @@
 #define VF_STUDIO_INTERNAL_H
 
 #include "vf/camera.h"
+#include "vf/object3d.h"
+#include "vf/rgb8.h"
 #include "vf/pose.h"
 #include "vf/rng.h"
 #include "vf/studio.h"
@@ -41,9 +43,57 @@ int vf__capture_walk(const vf_studio_capture_options *o, double **c2w);
 /* Render c2w[0..n) through the phone into video and write the truth document `truth` (stolen;
  * its "frames" are filled in here, each with the fields of extra[i] when extra is not NULL)
  * beside it. obj->transform.scale 0: fitted (and put in the truth). */
-struct vf_object3d;
 vf_status vf__film(const struct vf_object3d *obj, const vf_studio_phone *phone,
                    const double *c2w, int n, const json_t *extra, const char *video,
                    json_t *truth, json_t **report);
+
+/* A capture's truth file (vf/studio.h), loaded. */
+typedef struct capture_truth {
+    json_t *doc;
+    struct vf_object3d obj; /* model, transform, room */
+    vf_camera camera;       /* the upright frames */
+    double fps;
+    int count;
+    double *c2w;            /* count x 16, model frame */
+} capture_truth;
+
+vf_status vf__truth_load(const char *path, capture_truth *t);
+void vf__truth_free(capture_truth *t);
+
+/* The capture's truth file of a workspace: `given`, or the one beside the ingested video. */
+vf_status vf__truth_of_workspace(const vf_workspace *ws, const char *given, char *out,
+                                 size_t size);
+
+/* The similarity from the model's frame to the workspace's: the capture's true camera centres
+ * against the poses stage's, matched by the video frame each ingested image came from.
+ * *report gets {"frames", "scale", "rotation_median_deg", "position_median"}. */
+vf_status vf__align_workspace(const vf_workspace *ws, const capture_truth *t, vf_similarity *s,
+                              json_t **report);
+
+/* The phone's sensor on one rendered frame: exposure gain on linear light, shot and read
+ * noise scaled by `noise`. */
+void vf__develop(vf_rgb8 *img, double gain, double noise, vf_rng *rng);
+
+/* The upright frames dir/f00001.png... as the phone stores them (H.264, sideways, rotation
+ * flag) into video; FFmpeg's log in work/. */
+vf_status vf__encode(const char *dir, double fps, const char *video, const char *work);
+
+/* What reshoot's advice asked (vf_advice_text's words read back, as the person reads the
+ * screen): degrees, distances in workspace units. given = 0: no advice (NULL text). */
+typedef struct read_advice {
+    int given;
+    double orbit, raise, back, pan, tilt, roll;
+} read_advice;
+
+/* Read "orbit 12 deg right, raise 5 cm, step back 0.20 units, turn 3 deg left, tilt 2 deg up,
+ * roll 3 deg counterclockwise" (cm through metres_per_unit; "hold still: on target" is all
+ * zeros). */
+read_advice vf__read_advice(const char *text, double metres_per_unit);
+
+/* A closed-loop re-shoot (follow.c): the person moves by reshoot's advice. */
+vf_status vf__follow(vf_workspace *ws, capture_truth *t, const vf_similarity *to_ws,
+                     const vf_studio_phone *phone, const vf_studio_reshoot_options *o,
+                     const char *video, const char *truth_path, json_t *alignment,
+                     json_t **report);
 
 #endif
