@@ -92,6 +92,25 @@ static void test_advice(void)
     CHECK(strstr(text, "orbit 20 deg right") && strstr(text, "step back 5 cm") &&
               strstr(text, "raise 4 cm"),
           "advice: %s", text);
+    /* lower and closer, both cameras aimed at the object: no turn or tilt beyond keeping it
+     * in view (the words once said "tilt 30 deg up" too, and the studio's person looked over
+     * the object) */
+    c2w_of(-30, 0, 160, 0, -1, 0, goal);
+    vf_advice_compute(now, goal, &a);
+    CHECK(a.raise < -0.5 && a.back < -0.5, "lower %.2f, closer %.2f", a.raise, a.back);
+    CHECK_NEAR(a.pan_deg, 0, 1e-9);
+    CHECK_NEAR(a.tilt_deg, 0, 1e-9);
+    /* the same place, the camera turned 5 deg right and tilted 3 deg up */
+    double Ry[9], Rx[9], R[9], turn[16], zero[3] = {0, 0, 0};
+    vf_rot_y(-5 * M_PI / 180, Ry);
+    vf_rot_x(3 * M_PI / 180, Rx);
+    vf_mat3_mul(Ry, Rx, R);
+    vf_mat4_from_rt(R, zero, turn);
+    vf_mat4_mul(now, turn, goal);
+    vf_advice_compute(now, goal, &a);
+    CHECK(fabs(a.pan_deg - 5) < 0.1 && fabs(a.tilt_deg - 3) < 0.1, "turn %.2f, tilt %.2f",
+          a.pan_deg, a.tilt_deg);
+    CHECK(fabs(a.orbit_deg) < 1e-9 && fabs(a.raise) < 1e-9, "no step");
     roll_camera(now, -10, goal);
     vf_advice_compute(now, goal, &a);
     vf_advice_text(&a, 0, 2, 0.02, text, sizeof text);

@@ -76,14 +76,16 @@ typedef struct vf_advice {
     double orbit_deg;        /* move around the object: + right, - left */
     double raise;            /* + up, - down (scene units) */
     double back;             /* + step back, - step closer (scene units) */
-    double pan_deg;          /* then turn the camera: + right, - left */
+    double pan_deg;          /* then aim off the object: + right, - left */
     double tilt_deg;         /* + up, - down */
     double roll_deg;         /* + clockwise, - counterclockwise */
 } vf_advice;
 
 /* How to move from camera `current` to camera `target` (both c2w, object frame): orbit,
- * raise and step to the target's azimuth, height and distance; pan and tilt are measured
- * after the orbit (which turns the camera with it); roll about the optical axis. */
+ * raise and step to the target's azimuth, height and distance, keeping the object in view;
+ * pan and tilt are how much further the target aims off the object's centre (right, up) than
+ * the current camera does (0 for two cameras that both aim at the centre, wherever they
+ * stand); roll about the optical axis. */
 void vf_advice_compute(const double current[16], const double target[16], vf_advice *out);
 
 /* The advice as words, e.g. "orbit 12 deg right, raise 5 cm, step back 20 cm, roll 3 deg

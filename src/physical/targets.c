@@ -184,6 +184,31 @@ vf_status vf_targets_spread(const double *views, int n, const double range[6], i
 
 /* ---- guidance ---- */
 
+/* Where a camera aims, as angles off aiming at the object's centre from where it stands:
+ * right and up of the line to the centre (with world up as up). */
+static void aim_angles(const double c2w[16], double *pan_deg, double *tilt_deg)
+{
+    static const double z[3] = {0, 0, 1};
+    double p[3], f[3], u[3], f0[3], r0[3], u0[3];
+    camera_axes(c2w, p, f, u);
+    double d = sqrt(dot3(p, p));
+    for (int k = 0; k < 3; k++)
+        f0[k] = d > 0 ? -p[k] / d : 0;
+    cross3(f0, z, r0);
+    double rn = sqrt(dot3(r0, r0));
+    if (rn < 1e-9) { /* straight above or below the centre: no left or right */
+        *pan_deg = 0;
+        *tilt_deg = acos(fmax(-1, fmin(1, dot3(f, f0)))) * DEG;
+        return;
+    }
+    for (int k = 0; k < 3; k++)
+        r0[k] /= rn;
+    cross3(r0, f0, u0);
+    *pan_deg = atan2(dot3(f, r0), dot3(f, f0)) * DEG;
+    *tilt_deg = atan2(dot3(f, u0), sqrt(dot3(f, f0) * dot3(f, f0) + dot3(f, r0) * dot3(f, r0))) *
+                DEG;
+}
+
 void vf_advice_compute(const double current[16], const double target[16], vf_advice *out)
 {
     vf_target_words now, goal;
@@ -193,18 +218,15 @@ void vf_advice_compute(const double current[16], const double target[16], vf_adv
     out->raise = goal.height - now.height;
     out->back = goal.distance - now.distance;
     out->roll_deg = remainder(goal.roll_deg - now.roll_deg, 360.0);
-    /* Where the target camera looks, seen from the current camera once it has orbited
-     * (orbiting keeps facing the object): pan and tilt. */
-    double Rz[9], moved[16], orbit[16], zero[3] = {0, 0, 0};
-    vf_rot_z(out->orbit_deg / DEG, Rz);
-    vf_mat4_from_rt(Rz, zero, orbit);
-    vf_mat4_mul(orbit, current, moved);
-    double p[3], f[3], u[3], pt[3], ft[3], ut[3], r[3];
-    camera_axes(moved, p, f, u);
-    camera_axes(target, pt, ft, ut);
-    cross3(f, u, r); /* camera right */
-    out->pan_deg = atan2(dot3(ft, r), dot3(ft, f)) * DEG;
-    out->tilt_deg = atan2(dot3(ft, u), dot3(ft, f)) * DEG;
+    /* Pan and tilt as aim off the object: a person keeps the object in view while orbiting,
+     * rising and stepping, so "tilt up" must not count the tilt that lowering the camera
+     * already gives (measured in the studio's closed loop: "lower 2.2 units, tilt 30 deg up"
+     * from a camera aimed at the object turned the camera off it). */
+    double pan_now, tilt_now, pan_goal, tilt_goal;
+    aim_angles(current, &pan_now, &tilt_now);
+    aim_angles(target, &pan_goal, &tilt_goal);
+    out->pan_deg = remainder(pan_goal - pan_now, 360.0);
+    out->tilt_deg = tilt_goal - tilt_now;
 }
 
 static size_t add_step(char *out, size_t size, size_t used, const char *text)
