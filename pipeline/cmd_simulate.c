@@ -31,9 +31,11 @@ static const char usage[] =
     "                         reshoot: the capture's)\n"
     "      --fov DEG          vertical field of view (default 65; reshoot: the capture's)\n"
     "      --fps F            frames a second (default 30; reshoot: the capture's)\n"
-    "      --samples N        Cycles samples a pixel (default 4)\n"
+    "      --samples N        Cycles samples a pixel (default 8)\n"
     "      --shake S          scale of hand shake (default 1; 0: a tripod)\n"
     "      --noise S          scale of sensor noise and exposure drift (default 1; 0: none)\n"
+    "      --denoise H        the phone's denoising of each frame before encoding: non-local\n"
+    "                         means of strength H (default 6; 0: the raw grain)\n"
     "      --shutter S        open share of the frame interval (default 0.5; 0: no blur)\n"
     "      --seed N           every random choice (default 0)\n"
     "capture:\n"
@@ -60,7 +62,7 @@ static const char usage[] =
     CLI_COMMON_HELP;
 
 enum {
-    OPT_SIZE = CLI_OPT_FIRST_CUSTOM, OPT_FOV, OPT_FPS, OPT_SAMPLES, OPT_SHAKE, OPT_NOISE,
+    OPT_SIZE = CLI_OPT_FIRST_CUSTOM, OPT_FOV, OPT_FPS, OPT_SAMPLES, OPT_SHAKE, OPT_NOISE, OPT_DENOISE,
     OPT_SHUTTER, OPT_SEED, OPT_LOOPS, OPT_LOOP_SECONDS, OPT_ELEVATION, OPT_DISTANCE, OPT_TARGET,
     OPT_MODEL, OPT_TRUTH, OPT_WALK, OPT_HOLD, OPT_JITTER, OPT_FOLLOW, OPT_STARTS, OPT_GIVE_UP,
     OPT_TOLERANCE
@@ -90,6 +92,8 @@ static vf_status phone_option(int c, const char *arg, vf_studio_phone *p)
         s = cli_number("--shake", arg, 0, 10, &p->shake);
     else if (c == OPT_NOISE)
         s = cli_number("--noise", arg, 0, 10, &p->noise);
+    else if (c == OPT_DENOISE)
+        s = cli_number("--denoise", arg, 0, 50, &p->denoise);
     else if (c == OPT_SHUTTER)
         s = cli_number("--shutter", arg, 0, 1, &p->shutter);
     else if (c == OPT_SEED && (s = cli_count("--seed", arg, 0, LONG_MAX, &n)) == VF_OK)
@@ -108,6 +112,7 @@ static vf_status parse_options(int argc, char **argv, simulate_options *opt)
         {"samples", required_argument, NULL, OPT_SAMPLES},
         {"shake", required_argument, NULL, OPT_SHAKE},
         {"noise", required_argument, NULL, OPT_NOISE},
+        {"denoise", required_argument, NULL, OPT_DENOISE},
         {"shutter", required_argument, NULL, OPT_SHUTTER},
         {"seed", required_argument, NULL, OPT_SEED},
         {"loops", required_argument, NULL, OPT_LOOPS},

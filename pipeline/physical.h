@@ -29,7 +29,7 @@ enum {
 #define PHYSICAL_LOCALIZE_HELP                                                             \
     "      --camera FILE      intrinsics of the camera the frames come from (JSON: fl_x, fl_y,\n" \
     "                         cx, cy, w, h, k1, k2, p1, p2); default: the capture's camera\n" \
-    "      --min-inliers N    fewer inliers: not localized (default 30)\n"                 \
+    "      --min-inliers N    fewer inliers: not localized (default 20)\n"                 \
     "      --min-inlier-ratio F  fewer inliers per match: not localized (default 0.2)\n"   \
     "      --max-features N   SIFT features per frame (default 4096)\n"                 \
     "      --max-side PX      shrink frames to PX on the longer side first (default 1024;\n" \

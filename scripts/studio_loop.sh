@@ -8,12 +8,13 @@
 #   scripts/studio_loop.sh OUT_DIR [MODEL.glb ...]
 #
 # Default objects: the three recognised models of ../shared/data/models_3d that render
-# fastest (water bottle, bell pepper, folding chair). Settings are sized for 2 cores (15 to
-# 20 minutes an object measured, and about 6 more for the closed loop): 270x480 at 15 fps with a 1/60 s shutter, two loops of 6 s; the
-# field in object mode for 3 minutes; the re-shoot 4 s walking and 6 s around v*; a scoring
-# box of +-10% (the re-shoot wanders 3% of each range around v*). Each object's lines go to
-# OUT_DIR/NAME/loop.log, its check to OUT_DIR/NAME/check.json. Rerunning continues: the
-# stages keep what they finished.
+# fastest (water bottle, bell pepper, folding chair). Settings are sized for 2 cores (about
+# 23 minutes an object measured, and about 7 more for the closed loop, with the studio's
+# default 8 samples a pixel and the phone's denoising): 270x480 at 15 fps with a 1/60 s
+# shutter, two loops of 6 s; the field in object mode for 3 minutes; the re-shoot 4 s walking
+# and 6 s around v*; a scoring box of +-10% (the re-shoot wanders 3% of each range around v*).
+# Each object's lines go to OUT_DIR/NAME/loop.log, its check to OUT_DIR/NAME/check.json.
+# Rerunning continues: the stages keep what they finished.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 tool="${VF_TOOL:-$here/build/vfcapture}"

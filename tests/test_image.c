@@ -1,5 +1,5 @@
 /* Image module: file round trips, alpha, resizing, cropping, EXIF orientation (the same with
- * OpenImageIO and OpenCV) and error messages. */
+ * OpenImageIO and OpenCV), denoising and error messages. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -7,6 +7,7 @@
 #include "vf/fsutil.h"
 #include "vf/image.h"
 #include "vf/rgb8.h"
+#include "vf/rng.h"
 
 static float *pixel(const vf_image *img, int x, int y)
 {
@@ -335,6 +336,41 @@ static void test_exif_orientation(void)
     vf_image_free(&img);
 }
 
+/* The phone's denoising (the studio's): grain on two flat halves goes, the edge between them
+ * stays where it was and as steep. */
+static void test_denoise(void)
+{
+    vf_rgb8 img = {0};
+    CHECK(vf_rgb8_resize_buffer(&img, 64, 64) == VF_OK, "frame allocated");
+    vf_rng rng;
+    vf_rng_seed(&rng, 3);
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++)
+            for (int c = 0; c < 3; c++) {
+                double v = (x < 32 ? 60 : 190) + 8 * vf_rng_normal(&rng);
+                img.data[(y * 64 + x) * 3 + c] = (unsigned char)(v < 0 ? 0 : v > 255 ? 255 : v);
+            }
+    CHECK(vf_rgb8_denoise(&img, 6) == VF_OK, "denoised");
+    double sum = 0, sq = 0, n = 0, edge = 0;
+    for (int y = 0; y < 64; y++) {
+        for (int x = 4; x < 28; x++) {
+            double v = img.data[(y * 64 + x) * 3 + 1];
+            sum += v, sq += v * v, n++;
+        }
+        edge += img.data[(y * 64 + 33) * 3] - img.data[(y * 64 + 30) * 3];
+    }
+    double mean = sum / n, sd = sqrt(sq / n - mean * mean);
+    CHECK(fabs(mean - 60) < 2 && sd < 3, "flat half after denoising: mean %.1f (60), spread %.2f "
+          "(8 before)", mean, sd);
+    CHECK(edge / 64 > 120, "the edge stays: a step of %.0f across 3 pixels (130)", edge / 64);
+    vf_rgb8 same = {0};
+    CHECK(vf_rgb8_fit(&img, 64, &same) == VF_OK && vf_rgb8_denoise(&same, 0) == VF_OK &&
+              vf_rgb8_mean_abs_diff(&same, &img) == 0,
+          "strength 0 leaves the frame as it is");
+    vf_rgb8_free(&same);
+    vf_rgb8_free(&img);
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
@@ -348,6 +384,7 @@ int main(int argc, char **argv)
     CHECK_CASE(test_center_crop);
     CHECK_CASE(test_reorient);
     CHECK_CASE(test_exif_orientation);
+    CHECK_CASE(test_denoise);
     CHECK_CASE(test_errors);
     return check_finish();
 }

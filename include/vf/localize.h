@@ -43,7 +43,7 @@ typedef struct vf_localize_options {
     double ransac_px;        /* RANSAC inlier threshold, pixels of the working frame (default 6) */
     int ransac_iterations;   /* default 2000 */
     double loss_px;          /* Cauchy loss scale of the refinement, pixels (default 2) */
-    int min_inliers;         /* fewer inliers: not localized (default 30) */
+    int min_inliers;         /* fewer inliers: not localized (default 20) */
     double min_inlier_ratio; /* fewer inliers per ratio-tested match: not localized (0.2) */
     int has_camera;          /* use `camera` instead of the model's camera */
     vf_camera camera;        /* a calibration, for frames of its size (or aspect) */

@@ -60,6 +60,11 @@ vf_status vf_rgb8_save(const char *path, const vf_rgb8 *img);
  * ratio; an exact copy when it already fits. */
 vf_status vf_rgb8_fit(const vf_rgb8 *src, int max_side, vf_rgb8 *out);
 
+/* Remove grain and keep edges, as a phone's image processor does before it encodes: OpenCV's
+ * non-local means (7x7 patches, 21x21 search) on lightness and colour. strength is its h, in
+ * 8-bit levels (3: light, 10: strong; 0 leaves the frame as it is). In place. */
+vf_status vf_rgb8_denoise(vf_rgb8 *img, double strength);
+
 #ifdef __cplusplus
 }
 #endif

@@ -9,7 +9,9 @@
  * "center_viewpoint", "tolerance_percent", "model", "engine", "label", "kept" {"frames",
  * "misclassified", "asr", "interval95", "predicted"}, "natural" {... "error_rate" ...},
  * "rejected" {"blurry", "not_localized", "out_of_tolerance", "total"}, "frames",
- * "localize_fps", "mode", "frames_detail" [per frame]} and frames.csv.
+ * "localize_fps", "mode", "frames_detail" [per frame]}, frames.csv, and sheet.png: what the
+ * classifier saw of up to 36 frames spread over the input (its centre square, in object mode
+ * the cut-out), each with "on target" or "natural" and its class, red when fooled.
  *
  * When the field was trained in object mode (vf/train.h object_only), each localized frame is
  * cut out the same way (vf/cutout.h, posed by its localization) and classified on white, so

@@ -15,7 +15,8 @@
  *     9 Hz), a slight roll;
  *   - the camera: Cycles motion blur over the shutter (1/60 s at 30 fps), auto-exposure that
  *     drifts (+-10%), sensor noise (shot and read noise on linear light), few samples a pixel
- *     (Cycles' own noise adds to it), H.264 at CRF 20 through FFmpeg.
+ *     (Cycles' own noise adds to it), then the phone's denoising (non-local means: a phone's
+ *     frames are smooth, not grainy), H.264 at CRF 20 through FFmpeg.
  *
  * The truth file: {"kind": "vfcapture studio truth", "model", "transform" {"center",
  * "scale"} (the model's fit into the unit sphere, as vf_object3d_ingest records it),
@@ -50,10 +51,12 @@ typedef struct vf_studio_phone {
                               camera held upright) */
     double fps;            /* frames a second (default 30) */
     double shutter;        /* open share of the frame interval (default 0.5) */
-    int samples;           /* Cycles samples a pixel (default 4; its noise is part of the
+    int samples;           /* Cycles samples a pixel (default 8; its noise is part of the
                               sensor's) */
     double shake;          /* scale of hand shake and tremor (default 1; 0: a tripod) */
     double noise;          /* scale of sensor noise and exposure drift (default 1; 0: none) */
+    double denoise;        /* the phone's image processor removes grain before encoding:
+                              vf_rgb8_denoise's strength (default 6; 0: raw frames) */
     uint64_t seed;         /* every random choice (default 0) */
 } vf_studio_phone;
 

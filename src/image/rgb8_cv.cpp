@@ -7,6 +7,7 @@
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/photo.hpp>
 
 #include <strings.h>
 
@@ -199,5 +200,22 @@ extern "C" vf_status vf_rgb8_fit(const vf_rgb8 *src, int max_side, vf_rgb8 *out)
         return vf_fail(VF_EINTERNAL, "resizing a frame failed: %s", e.err.c_str());
     }
     *out = img;
+    return VF_OK;
+}
+
+extern "C" vf_status vf_rgb8_denoise(vf_rgb8 *img, double strength)
+{
+    if (strength <= 0)
+        return VF_OK;
+    try {
+        cv::Mat pixels = wrap(img), clean;
+        cv::fastNlMeansDenoisingColored(pixels, clean, (float)strength, (float)strength, 7, 21);
+        clean.copyTo(pixels);
+    } catch (const cv::Exception &e) {
+        return vf_fail(VF_EINTERNAL, "denoising a frame failed: %s", e.err.c_str());
+    } catch (const std::bad_alloc &) {
+        return vf_fail(VF_EINTERNAL, "out of memory denoising a %dx%d frame", img->width,
+                       img->height);
+    }
     return VF_OK;
 }

@@ -30,7 +30,7 @@ void vf_localize_defaults(vf_localize_options *opt)
 {
     *opt = (vf_localize_options){.max_features = 4096, .max_side = 1024, .ratio = 0.8,
                                  .ransac_px = 6, .ransac_iterations = 2000, .loss_px = 2,
-                                 .min_inliers = 30, .min_inlier_ratio = 0.2};
+                                 .min_inliers = 20, .min_inlier_ratio = 0.2};
 }
 
 /* ---- the map ---- */

@@ -14,6 +14,7 @@
 #include "vf/frames.h"
 #include "vf/log.h"
 #include "vf/object3d.h"
+#include "vf/plot.h"
 #include "vf/pose.h"
 #include "vf/resources.h"
 #include "vf/sharpness.h"
@@ -25,6 +26,10 @@ typedef struct tally {
     int frames, misclassified;
     int class_count[VF_NUM_CLASSES];
 } tally;
+
+/* sheet.png: every so many classified frames, the square the classifier saw, small */
+#define SHEET_MAX 36
+#define SHEET_SIDE 112
 
 typedef struct score_run {
     const vf_score_options *opt;
@@ -45,6 +50,11 @@ typedef struct score_run {
     int object_mode;         /* the field was trained on the object cut out (vf/cutout.h) */
     vf_object_points object; /* then each frame is cut out the same way before classifying */
     vf_cutout_options cutout;
+    int classified;               /* frames classified so far */
+    vf_image sheet[SHEET_MAX];    /* what the classifier saw of some of them */
+    char *caption[SHEET_MAX];
+    int fooled[SHEET_MAX];
+    int sheet_count;
 } score_run;
 
 static vf_status open_classifier(score_run *run)
@@ -133,10 +143,24 @@ static vf_status open_object_mode(score_run *run, const vf_workspace *ws)
     return status;
 }
 
+/* The classifier's centre square of img (the crop vf_classifier_preprocess takes), small. */
+static vf_status thumbnail(const vf_image *img, vf_image *out)
+{
+    int shorter = img->width < img->height ? img->width : img->height;
+    int side = (int)lround(shorter * 224.0 / 256.0);
+    vf_image square = {0};
+    vf_status status = vf_image_center_crop(img, side, side, &square);
+    if (status == VF_OK)
+        status = vf_image_resize(&square, SHEET_SIDE, SHEET_SIDE, out);
+    vf_image_free(&square);
+    return status;
+}
+
 /* Classify one frame (in object mode its object cut out onto white, posed by c2w): the top
- * class; *coverage gets the object's share of the frame (1 outside object mode). */
+ * class; *coverage gets the object's share of the frame (1 outside object mode). thumb (may
+ * be NULL) gets what the classifier saw, small. */
 static vf_status classify(score_run *run, const vf_rgb8 *frame, const double c2w[16], int *top,
-                          float *p, double *coverage)
+                          float *p, double *coverage, vf_image *thumb)
 {
     vf_image img = {0};
     uint8_t *mask = NULL;
@@ -159,6 +183,8 @@ static vf_status classify(score_run *run, const vf_rgb8 *frame, const double c2w
         *coverage = n ? (double)on / n : 0;
         status = vf_classifier_classify_images(run->cls, &img, 1, probs);
     }
+    if (status == VF_OK && thumb)
+        status = thumbnail(&img, thumb);
     free(mask);
     if (status == VF_OK)
         vf_topk(probs, 1, top, p);
@@ -209,8 +235,22 @@ static vf_status score_frame(score_run *run, const vf_rgb8 *frame, const vf_fram
     int top;
     float p;
     double coverage;
-    if ((status = classify(run, frame, r.c2w_object, &top, &p, &coverage)) != VF_OK)
+    int stride = run->frame_count / SHEET_MAX + 1;
+    vf_image *thumb = run->classified++ % stride == 0 && run->sheet_count < SHEET_MAX
+                          ? &run->sheet[run->sheet_count]
+                          : NULL;
+    if ((status = classify(run, frame, r.c2w_object, &top, &p, &coverage, thumb)) != VF_OK)
         return status;
+    if (thumb) {
+        char caption[160];
+        const char *tail = strrchr(info->name, '#'); /* a video's frame number */
+        if (!tail)
+            tail = (tail = strrchr(info->name, '/')) ? tail + 1 : info->name;
+        snprintf(caption, sizeof caption, "%.40s %s\n%s %.0f%%", tail,
+                 inside ? "on target" : "natural", vf_class_short_name(top), 100 * p);
+        run->caption[run->sheet_count] = strdup(caption);
+        run->fooled[run->sheet_count++] = !vf_attack_is_label(&run->attack, top);
+    }
     if (run->object_mode)
         json_object_set_new(row, "object_coverage", json_real(coverage));
     json_object_set_new(row, "class", json_integer(top));
@@ -334,6 +374,10 @@ static vf_status save_results(vf_workspace *ws, const score_run *run, json_t *re
     if (status == VF_OK &&
         (status = vf_path_join(path, sizeof path, stage.dir, "frames.csv")) == VF_OK)
         status = write_frames_csv(path, run->frames);
+    if (status == VF_OK && run->sheet_count > 0 &&
+        (status = vf_path_join(path, sizeof path, stage.dir, "sheet.png")) == VF_OK)
+        status = vf_contact_sheet(path, run->sheet, (const char *const *)run->caption,
+                                  run->fooled, run->sheet_count, 6);
     if (status == VF_OK)
         status = vf_stage_commit(&stage,
                                  json_pack("{s:f, s:s}", "tolerance_percent",
@@ -394,6 +438,10 @@ vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
     vf_classifier_close(run.cls);
     vf_attack_file_free(&run.attack);
     json_decref(run.frames);
+    for (int i = 0; i < run.sheet_count; i++) {
+        vf_image_free(&run.sheet[i]);
+        free(run.caption[i]);
+    }
     return status;
 }
 /* ---- the summary across workspaces ---- */

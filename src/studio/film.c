@@ -32,9 +32,11 @@ static vf_status work_dir(const char *video, char *out, size_t size)
 }
 
 /* What the phone's sensor does to frame i: a drifting auto-exposure gain on linear light, then
- * shot noise (grows with the light) and read noise, then sRGB again. */
-void vf__develop(vf_rgb8 *img, double gain, double noise, vf_rng *rng)
+ * shot noise (grows with the light) and read noise, then sRGB again; then its image processor
+ * takes the grain out (Cycles' and the sensor's alike). */
+vf_status vf__develop(vf_rgb8 *img, double gain, const vf_studio_phone *phone, vf_rng *rng)
 {
+    const double noise = phone->noise;
     static float linear[256];
     if (linear[255] == 0)
         for (int v = 0; v < 256; v++) {
@@ -51,6 +53,7 @@ void vf__develop(vf_rgb8 *img, double gain, double noise, vf_rng *rng)
         double s = l <= 0.0031308 ? 12.92 * l : 1.055 * pow(l, 1 / 2.4) - 0.055;
         img->data[i] = (unsigned char)lrint(255 * s);
     }
+    return vf_rgb8_denoise(img, phone->denoise);
 }
 
 static vf_status run_ffmpeg(const char *program, vf_args *args, FILE *log, const char *what)
@@ -189,8 +192,9 @@ vf_status vf__film(const vf_object3d *obj, const vf_studio_phone *phone, const d
             status = vf_rgb8_load(in, &img);
         if (status == VF_OK) {
             vf_rng_seed(&rng, phone->seed * 1000003ULL + (uint64_t)i);
-            vf__develop(&img, exp(vf__wave_at(&exposure, i / phone->fps)), phone->noise, &rng);
-            status = vf_rgb8_save(out, &img);
+            status = vf__develop(&img, exp(vf__wave_at(&exposure, i / phone->fps)), phone, &rng);
+            if (status == VF_OK)
+                status = vf_rgb8_save(out, &img);
         }
     }
     vf_rgb8_free(&img);

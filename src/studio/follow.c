@@ -193,11 +193,12 @@ static vf_status next_frame(void *ctx, vf_rgb8 *frame, int *got)
     if (status == VF_OK) {
         vf_rng rng;
         vf_rng_seed(&rng, f->phone->seed * 1000003ULL + (uint64_t)f->filmed + 7777);
-        vf__develop(frame, exp(vf__wave_at(&f->exposure, f->filmed * dt)), f->phone->noise,
-                    &rng);
+        status = vf__develop(frame, exp(vf__wave_at(&f->exposure, f->filmed * dt)), f->phone,
+                             &rng);
         char name[32], path[VF_PATH_MAX];
         snprintf(name, sizeof name, "f%05d.png", f->filmed + 1);
-        status = vf_path_join(path, sizeof path, f->film_dir, name);
+        if (status == VF_OK)
+            status = vf_path_join(path, sizeof path, f->film_dir, name);
         if (status == VF_OK)
             status = vf_rgb8_save(path, frame);
     }
@@ -372,13 +373,13 @@ vf_status vf__follow(vf_workspace *ws, capture_truth *t, const vf_similarity *to
         vf_camera c = cam;
         json_t *truth = json_pack(
             "{s:s, s:s, s:s, s:s, s:s, s:i, s:o, s:O, s:{s:b, s:i, s:f, s:f, s:f, s:f, s:f, "
-            "s:I}, s:O, s:{s:i, s:i, s:f, s:f, s:f, s:f}, s:f, s:O, s:{s:[f,f,f], s:f}}",
+            "s:f, s:I}, s:O, s:{s:i, s:i, s:f, s:f, s:f, s:f}, s:f, s:O, s:{s:[f,f,f], s:f}}",
             "kind", "vfcapture studio truth", "simulation", "reshoot", "model", t->obj.model,
             "capture_truth", truth_path, "workspace", ws->root, "target", o->target,
             "target_viewpoint", vf_viewpoint_json(&f.target), "alignment", alignment, "walk",
             "follow", 1, "starts", o->starts, "hold_seconds", o->hold_seconds,
             "give_up_seconds", o->give_up_seconds, "tolerance", o->tolerance, "shake",
-            phone->shake, "noise", phone->noise, "seed", (json_int_t)phone->seed, "walks",
+            phone->shake, "noise", phone->noise, "denoise", phone->denoise, "seed", (json_int_t)phone->seed, "walks",
             walks, "camera", "width", c.width, "height", c.height, "fx", c.fx, "fy", c.fy, "cx",
             c.cx, "cy", c.cy, "fps", phone->fps, "frames", f.frames, "transform", "center",
             t->obj.transform.center[0], t->obj.transform.center[1], t->obj.transform.center[2],

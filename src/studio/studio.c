@@ -20,7 +20,7 @@
 static void phone_defaults(vf_studio_phone *p)
 {
     *p = (vf_studio_phone){.width = 360, .height = 640, .fov_y = 65, .fps = 30, .shutter = 0.5,
-                           .samples = 4, .shake = 1, .noise = 1, .seed = 0};
+                           .samples = 8, .shake = 1, .noise = 1, .denoise = 6, .seed = 0};
 }
 
 void vf_studio_capture_defaults(vf_studio_capture_options *o)
@@ -55,9 +55,9 @@ static vf_status check_phone(const vf_studio_phone *p)
         return vf_fail(VF_EINPUT, "frame size %dx%d is not one a phone films", p->width, p->height);
     if (!(p->fov_y > 5 && p->fov_y < 170) || !(p->fps >= 1 && p->fps <= 240) ||
         !(p->shutter >= 0 && p->shutter <= 1) || p->samples < 1 || !(p->shake >= 0) ||
-        !(p->noise >= 0))
+        !(p->noise >= 0) || !(p->denoise >= 0 && p->denoise <= 50))
         return vf_fail(VF_EINPUT, "the phone's settings are out of range (field of view 5-170 "
-                                  "deg, 1-240 fps, shutter 0-1, samples >= 1)");
+                                  "deg, 1-240 fps, shutter 0-1, samples >= 1, denoise 0-50)");
     return VF_OK;
 }
 
@@ -98,12 +98,12 @@ vf_status vf_studio_capture(const char *model, const vf_studio_capture_options *
     vf_info("filming %s: %d loops of %.0f s, %d frames %dx%d at %.0f fps", model, o->loops,
             o->loop_seconds, n, o->phone.width, o->phone.height, o->phone.fps);
     json_t *truth = json_pack(
-        "{s:s, s:s, s:s, s:{s:i, s:f, s:f, s:f, s:f, s:i, s:f, s:f, s:f, s:I}}", "kind",
+        "{s:s, s:s, s:s, s:{s:i, s:f, s:f, s:f, s:f, s:i, s:f, s:f, s:f, s:f, s:I}}", "kind",
         "vfcapture studio truth", "simulation", "capture", "model", obj.model, "walk", "loops",
         o->loops, "loop_seconds", o->loop_seconds, "elevation_low", o->elevation_low,
         "elevation_high", o->elevation_high, "distance", o->distance, "samples", o->phone.samples,
-        "shutter", o->phone.shutter, "shake", o->phone.shake, "noise", o->phone.noise, "seed",
-        (json_int_t)o->phone.seed);
+        "shutter", o->phone.shutter, "shake", o->phone.shake, "noise", o->phone.noise,
+        "denoise", o->phone.denoise, "seed", (json_int_t)o->phone.seed);
     status = vf__film(&obj, &o->phone, c2w, n, NULL, video, truth, report);
     free(c2w);
     return status;
@@ -386,13 +386,14 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
         vf_similarity_to_mat4(&to_ws, m);
         json_object_set_new(alignment, "model_to_workspace", vf_json_doubles(m, 16));
         json_t *truth = json_pack(
-            "{s:s, s:s, s:s, s:s, s:s, s:i, s:o, s:O, s:{s:f, s:f, s:f, s:f, s:f, s:f, s:I}}",
+            "{s:s, s:s, s:s, s:s, s:s, s:i, s:o, s:O, s:{s:f, s:f, s:f, s:f, s:f, s:f, s:f, "
+            "s:I}}",
             "kind", "vfcapture studio truth", "simulation", "reshoot", "model", t.obj.model,
             "capture_truth", truth_path, "workspace", ws->root, "target", o->target,
             "target_viewpoint", vf_viewpoint_json(&target), "alignment", alignment, "walk",
             "walk_seconds", o->walk_seconds, "hold_seconds", o->hold_seconds, "jitter",
             o->jitter, "shutter", phone.shutter, "shake", phone.shake, "noise", phone.noise,
-            "seed", (json_int_t)phone.seed);
+            "denoise", phone.denoise, "seed", (json_int_t)phone.seed);
         t.obj.samples = phone.samples;
         status = vf__film(&t.obj, &phone, c2w, n, extra, video, truth, report);
         if (status == VF_OK && report && *report)

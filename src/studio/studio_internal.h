@@ -71,8 +71,8 @@ vf_status vf__align_workspace(const vf_workspace *ws, const capture_truth *t, vf
                               json_t **report);
 
 /* The phone's sensor on one rendered frame: exposure gain on linear light, shot and read
- * noise scaled by `noise`. */
-void vf__develop(vf_rgb8 *img, double gain, double noise, vf_rng *rng);
+ * noise scaled by phone->noise, then the image processor's denoising (phone->denoise). */
+vf_status vf__develop(vf_rgb8 *img, double gain, const vf_studio_phone *phone, vf_rng *rng);
 
 /* The upright frames dir/f00001.png... as the phone stores them (H.264, sideways, rotation
  * flag) into video; FFmpeg's log in work/. */
