@@ -3,7 +3,8 @@
 # fail with one clear line while an existing workspace stays exactly as it was and a new one is
 # not left behind: a file that is not a glTF, a compressed glTF (EXT_meshopt_compression, which
 # Debian's Blender importer lacks), a model whose only material is fully transparent (it
-# renders empty), a model whose vertices are all at one point, a missing Blender, and `real` on
+# renders empty), a model whose vertices are all at one point, a Blender that hangs (stopped
+# after $VF_BLENDER_TIMEOUT silent seconds), a missing Blender, and `real` on
 # a workspace that was not made from a model or has no attack yet; and that `--scene room` renders
 # opaque RGB views and records its scene.
 source "$(dirname "$0")/shell_checks.sh"
@@ -75,6 +76,10 @@ grep -q "gltf-transform" "$tmp/err" && ok || bad "the compressed glTF's line say
 fails 1 "transparent model" "renders empty" "$tmp/clear.gltf"
 fails 1 "degenerate model" "one point" "$tmp/point.gltf"
 fails 1 "missing model" "no such file" "$tmp/nothing.glb"
+printf '#!/bin/sh\necho "Blender 3.4.1"\nexec sleep 60\n' >"$tmp/hung-blender"
+chmod +x "$tmp/hung-blender"
+fails 1 "a Blender that hangs" "printed nothing for 2 s" "$models/bell_pepper__yellow_bell_pepper.glb" \
+  VF_BLENDER="$tmp/hung-blender" VF_BLENDER_TIMEOUT=2
 fails 2 "missing Blender" "blender is not installed" "$models/bell_pepper__yellow_bell_pepper.glb" \
   PATH=/nonexistent VF_BLENDER=
 snapshot >"$tmp/after"

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "vf/log.h"
 #include "vf/process.h"
 
 static int run(const char *program, const char *arg, int *exit_code, int *sig)
@@ -52,10 +53,46 @@ static void test_lost_status(void)
     close(channel);
 }
 
+static void count_line(const char *line, void *ctx)
+{
+    (void)line;
+    ++*(int *)ctx;
+}
+
+/* A child that goes silent is stopped after the idle limit; one that keeps talking is not. */
+static void test_idle_timeout(void)
+{
+    vf_args args = {0};
+    vf_args_add(&args, "-c");
+    vf_args_add(&args, "echo start; exec sleep 30");
+    int code, sig, timed_out, lines = 0;
+    double start = vf_now();
+    CHECK(vf_process_run_watched("/bin/sh", &args, NULL, count_line, &lines, 0.5, &code, &sig,
+                                 &timed_out) == VF_OK,
+          "run");
+    double took = vf_now() - start;
+    CHECK(timed_out && code == -1 && sig == SIGKILL && lines == 1,
+          "silent child: timed out %d, code %d, signal %d, %d lines", timed_out, code, sig, lines);
+    CHECK(took < 5, "stopped after %.1f s, not 30", took);
+    vf_args_free(&args);
+
+    vf_args_add(&args, "-c");
+    vf_args_add(&args, "for i in 1 2 3 4; do echo $i; sleep 0.2; done; printf tail; exit 3");
+    lines = 0;
+    CHECK(vf_process_run_watched("/bin/sh", &args, NULL, count_line, &lines, 1.0, &code, &sig,
+                                 &timed_out) == VF_OK,
+          "run");
+    CHECK(!timed_out && code == 3 && lines == 5,
+          "talking child: timed out %d, code %d, %d lines (4 and a last one without newline)",
+          timed_out, code, lines);
+    vf_args_free(&args);
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
     CHECK_CASE(test_exit_codes);
     CHECK_CASE(test_lost_status);
+    CHECK_CASE(test_idle_timeout);
     return check_finish();
 }

@@ -57,6 +57,13 @@ typedef void (*vf_process_line_fn)(const char *line, void *ctx);
 vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
                          vf_process_line_fn on_line, void *ctx, int *exit_code, int *signal_out);
 
+/* vf_process_run for a program that may hang on untrusted input (Blender on a model): when
+ * the child prints nothing for idle_timeout_s seconds (0: no limit) it is killed (SIGKILL),
+ * and *timed_out (may be NULL) is set; *exit_code is then -1 and *signal_out SIGKILL. */
+vf_status vf_process_run_watched(const char *program, const vf_args *args, FILE *log,
+                                 vf_process_line_fn on_line, void *ctx, double idle_timeout_s,
+                                 int *exit_code, int *signal_out, int *timed_out);
+
 /* Start `program args...` without waiting: *channel gets the caller's end of a socket whose
  * other end is the child's fd 3, the child's stdin is /dev/null and its stdout and stderr go to
  * output_fd. Both of the caller's descriptors are close-on-exec, so later children do not keep

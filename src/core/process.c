@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <stdarg.h>
@@ -116,37 +117,79 @@ static vf_status spawn(const char *program, const vf_args *args, int out_fd, int
     return VF_OK;
 }
 
-/* Copy the child's output to the log and the callback, line by line. */
-static void follow_output(int fd, FILE *log, vf_process_line_fn on_line, void *ctx)
+/* Hand one line of the child's output (newline included when it had one) to the log and the
+ * callback. */
+static void take_line(char *line, size_t len, FILE *log, vf_process_line_fn on_line, void *ctx)
 {
-    FILE *in = fdopen(fd, "r");
-    if (!in) {
-        close(fd);
-        return;
+    if (log)
+        fwrite(line, 1, len, log);
+    if (len && line[len - 1] == '\n')
+        len--;
+    line[len] = '\0';
+    if (on_line)
+        on_line(line, ctx);
+}
+
+/* Copy the child's output to the log and the callback, line by line, until it closes its end
+ * (a line longer than the buffer is handed over in pieces). Returns 0 then, or 1 when it
+ * printed nothing for idle_timeout_s seconds (0: no limit). */
+static int follow_output(int fd, FILE *log, vf_process_line_fn on_line, void *ctx,
+                         double idle_timeout_s)
+{
+    enum { CAP = 1 << 16 };
+    char buf[CAP + 1];
+    size_t len = 0;
+    int timed_out = 0;
+    for (;;) {
+        struct pollfd pfd = {.fd = fd, .events = POLLIN};
+        int ready = poll(&pfd, 1, idle_timeout_s > 0 ? (int)(1000 * idle_timeout_s) : -1);
+        if (ready < 0 && errno == EINTR)
+            continue;
+        if (ready == 0)
+            timed_out = 1;
+        ssize_t n = ready > 0 ? read(fd, buf + len, CAP - len) : -1;
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            break;
+        len += (size_t)n;
+        size_t begin = 0;
+        for (size_t i = len - (size_t)n; i < len; i++)
+            if (buf[i] == '\n') {
+                take_line(buf + begin, i + 1 - begin, log, on_line, ctx);
+                begin = i + 1;
+            }
+        if (begin == 0 && len == CAP) { /* a full buffer without a newline */
+            take_line(buf, len, log, on_line, ctx);
+            begin = len;
+        }
+        memmove(buf, buf + begin, len - begin);
+        len -= begin;
     }
-    char *line = NULL;
-    size_t cap = 0;
-    ssize_t len;
-    while ((len = getline(&line, &cap, in)) > 0) {
-        if (log)
-            fwrite(line, 1, (size_t)len, log);
-        if (line[len - 1] == '\n')
-            line[len - 1] = '\0';
-        if (on_line)
-            on_line(line, ctx);
-    }
-    free(line);
-    fclose(in);
+    if (len) /* a last line without a newline */
+        take_line(buf, len, log, on_line, ctx);
+    close(fd);
     if (log)
         fflush(log);
+    return timed_out;
 }
 
 vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
                          vf_process_line_fn on_line, void *ctx, int *exit_code, int *signal_out)
 {
+    return vf_process_run_watched(program, args, log, on_line, ctx, 0, exit_code, signal_out,
+                                  NULL);
+}
+
+vf_status vf_process_run_watched(const char *program, const vf_args *args, FILE *log,
+                                 vf_process_line_fn on_line, void *ctx, double idle_timeout_s,
+                                 int *exit_code, int *signal_out, int *timed_out)
+{
     *exit_code = -1;
     if (signal_out)
         *signal_out = 0;
+    if (timed_out)
+        *timed_out = 0;
     int fds[2];
     if (pipe2(fds, O_CLOEXEC) != 0)
         return vf_fail(VF_EINTERNAL, "cannot create a pipe: %s", strerror(errno));
@@ -157,7 +200,11 @@ vf_status vf_process_run(const char *program, const vf_args *args, FILE *log,
         close(fds[0]);
         return status;
     }
-    follow_output(fds[0], log, on_line, ctx);
+    if (follow_output(fds[0], log, on_line, ctx, idle_timeout_s)) {
+        kill(pid, SIGKILL);
+        if (timed_out)
+            *timed_out = 1;
+    }
     int wstatus = 0;
     pid_t done;
     while ((done = waitpid(pid, &wstatus, 0)) < 0 && errno == EINTR)

@@ -21,6 +21,15 @@
 #define SCRIPT_UNCAUGHT 3 /* --python-exit-code: an exception the script did not expect */
 #define SCRIPT_SETUP_ERROR 4
 
+/* How long Blender may print nothing (import a large model, render one view) before it is
+ * taken for hung and stopped: $VF_BLENDER_TIMEOUT seconds, default 10 minutes. */
+static int blender_silent_s(void)
+{
+    const char *env = getenv("VF_BLENDER_TIMEOUT");
+    long s = env ? strtol(env, NULL, 10) : 0;
+    return s > 0 && s < 86400 ? (int)s : 600;
+}
+
 void vf__blender_view_file(const char *prefix, int i, char *out, size_t size)
 {
     snprintf(out, size, "%s%03d.png", prefix, i);
@@ -181,9 +190,10 @@ vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
     }
     follow f = {.shown = job->label != NULL};
     vf_progress_begin(&f.progress, job->label, (size_t)job->count, "views");
-    int exit_code, sig;
+    int exit_code, sig, timed_out, silent_s = blender_silent_s();
     double start = vf_now();
-    status = vf_process_run(program, &args, log, on_line, &f, &exit_code, &sig);
+    status = vf_process_run_watched(program, &args, log, on_line, &f, silent_s, &exit_code, &sig,
+                                    &timed_out);
     if (f.shown)
         vf_progress_end(&f.progress);
     fprintf(log, "# blender: exit %d, %.1f s\n", exit_code, vf_now() - start);
@@ -192,6 +202,11 @@ vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
     if (status != VF_OK)
         return status;
 
+    if (timed_out) /* a model that hangs the importer or the renderer must not hang us */
+        return vf_fail(VF_EINPUT,
+                       "Blender printed nothing for %d s rendering %s and was stopped; see %s "
+                       "(VF_BLENDER_TIMEOUT sets the limit)",
+                       silent_s, job->model, log_path);
     if (exit_code == SCRIPT_INPUT_ERROR)
         return vf_fail(VF_EINPUT, "%s", f.error);
     if (exit_code == SCRIPT_SETUP_ERROR)
@@ -215,8 +230,6 @@ vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
 
 /* ---- a live camera: one Blender kept open, one view a request ---- */
 
-#define LIVE_LOAD_TIMEOUT_S 600  /* importing a large model */
-#define LIVE_RENDER_TIMEOUT_S 300
 
 struct vf_object3d_live {
     int pid, channel;
@@ -312,7 +325,7 @@ vf_status vf_object3d_live_open(const vf_object3d *obj, const vf_camera *cam, co
         close(log_fd);
     vf_args_free(&args);
     if (status == VF_OK)
-        status = live_read_line(live, line, sizeof line, LIVE_LOAD_TIMEOUT_S, "loading");
+        status = live_read_line(live, line, sizeof line, blender_silent_s(), "loading");
     if (status == VF_OK && strcmp(line, "ready") != 0)
         status = vf_fail(VF_EINTERNAL, "Blender said '%s' instead of 'ready' loading %s", line,
                          obj->model);
@@ -349,7 +362,7 @@ vf_status vf_object3d_live_render(vf_object3d_live *live, const double c2w[16], 
     }
     free(text);
     if (status == VF_OK)
-        status = live_read_line(live, line, sizeof line, LIVE_RENDER_TIMEOUT_S, "rendering");
+        status = live_read_line(live, line, sizeof line, blender_silent_s(), "rendering");
     if (status == VF_OK && strncmp(line, "done ", 5) != 0)
         status = vf_fail(VF_EINTERNAL, "Blender could not render %s: %s", live->model,
                          strncmp(line, "vf-error: ", 10) ? line : line + 10);
