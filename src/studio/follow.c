@@ -379,8 +379,8 @@ vf_status vf__follow(vf_workspace *ws, capture_truth *t, const vf_similarity *to
             "target_viewpoint", vf_viewpoint_json(&f.target), "alignment", alignment, "walk",
             "follow", 1, "starts", o->starts, "hold_seconds", o->hold_seconds,
             "give_up_seconds", o->give_up_seconds, "tolerance", o->tolerance, "shake",
-            phone->shake, "noise", phone->noise, "denoise", phone->denoise, "seed", (json_int_t)phone->seed, "walks",
-            walks, "camera", "width", c.width, "height", c.height, "fx", c.fx, "fy", c.fy, "cx",
+            phone->shake, "noise", phone->noise, "denoise", phone->denoise, "seed",
+            (json_int_t)phone->seed, "walks", walks, "camera", "width", c.width, "height", c.height, "fx", c.fx, "fy", c.fy, "cx",
             c.cx, "cy", c.cy, "fps", phone->fps, "frames", f.frames, "transform", "center",
             t->obj.transform.center[0], t->obj.transform.center[1], t->obj.transform.center[2],
             "scale", t->obj.transform.scale);
