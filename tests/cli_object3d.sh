@@ -4,7 +4,7 @@
 # not left behind: a file that is not a glTF, a compressed glTF (EXT_meshopt_compression, which
 # Debian's Blender importer lacks), a model whose only material is fully transparent (it
 # renders empty), a model whose vertices are all at one point, a Blender that hangs (stopped
-# after $VF_BLENDER_TIMEOUT silent seconds), a missing Blender, and `real` on
+# after $VF_BLENDER_TIMEOUT silent seconds; its log is kept in $TMPDIR), a missing Blender, and `real` on
 # a workspace that was not made from a model or has no attack yet; and that `--scene room` renders
 # opaque RGB views and records its scene.
 source "$(dirname "$0")/shell_checks.sh"
@@ -79,7 +79,10 @@ fails 1 "missing model" "no such file" "$tmp/nothing.glb"
 printf '#!/bin/sh\necho "Blender 3.4.1"\nexec sleep 60\n' >"$tmp/hung-blender"
 chmod +x "$tmp/hung-blender"
 fails 1 "a Blender that hangs" "printed nothing for 2 s" "$models/bell_pepper__yellow_bell_pepper.glb" \
-  VF_BLENDER="$tmp/hung-blender" VF_BLENDER_TIMEOUT=2
+  VF_BLENDER="$tmp/hung-blender" VF_BLENDER_TIMEOUT=2 TMPDIR="$tmp"
+kept=$(grep -o "Blender's log: [^)]*" "$tmp/err" | cut -d' ' -f3)
+[ -n "$kept" ] && grep -q "Blender 3.4.1" "$kept" && ok ||
+  bad "the line names Blender's log, kept outside the removed staging folder"
 fails 2 "missing Blender" "blender is not installed" "$models/bell_pepper__yellow_bell_pepper.glb" \
   PATH=/nonexistent VF_BLENDER=
 snapshot >"$tmp/after"

@@ -36,6 +36,12 @@ vf_status vf_read_file(const char *path, char **data, size_t *size);
 vf_status vf_write_file_atomic(const char *path, const void *data, size_t size);
 vf_status vf_copy_file(const char *src, const char *dst);
 
+/* A failed stage's log (COLMAP's, Blender's) lives in the staging folder, which the failure
+ * removes: copy it to $TMPDIR (or /tmp) as vfcapture-<who>-XXXXXX.log and append "(<who>'s
+ * log: PATH)" to the current error message. Returns `status` unchanged; does nothing when the
+ * log is missing or empty. */
+vf_status vf_keep_failure_log(const char *log_path, const char *who, vf_status status);
+
 /* Whether path's extension (after its last '.', any case) is one of exts (NULL-terminated,
  * without dots: {"jpg", "png", NULL}). */
 int vf_path_has_extension(const char *path, const char *const *exts);

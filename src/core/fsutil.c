@@ -259,3 +259,23 @@ void vf_free_names(char **names, int count)
         free(names[i]);
     free(names);
 }
+
+vf_status vf_keep_failure_log(const char *log_path, const char *who, vf_status status)
+{
+    struct stat info;
+    if (!log_path || !log_path[0] || stat(log_path, &info) != 0 || info.st_size == 0)
+        return status;
+    const char *tmp = getenv("TMPDIR");
+    char copy[VF_PATH_MAX], message[1024];
+    snprintf(copy, sizeof copy, "%s/vfcapture-%s-XXXXXX.log", tmp && *tmp ? tmp : "/tmp", who);
+    int fd = mkstemps(copy, 4);
+    if (fd < 0)
+        return status;
+    close(fd);
+    snprintf(message, sizeof message, "%s", vf_error_message());
+    if (vf_copy_file(log_path, copy) == VF_OK)
+        vf_fail(status, "%s (%s's log: %s)", message, who, copy);
+    else
+        unlink(copy);
+    return status;
+}

@@ -203,10 +203,12 @@ vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
         return status;
 
     if (timed_out) /* a model that hangs the importer or the renderer must not hang us */
-        return vf_fail(VF_EINPUT,
-                       "Blender printed nothing for %d s rendering %s and was stopped; see %s "
-                       "(VF_BLENDER_TIMEOUT sets the limit)",
-                       silent_s, job->model, log_path);
+        return vf_keep_failure_log(
+            log_path, "Blender",
+            vf_fail(VF_EINPUT,
+                    "Blender printed nothing for %d s rendering %s and was stopped "
+                    "(VF_BLENDER_TIMEOUT sets the limit)",
+                    silent_s, job->model));
     if (exit_code == SCRIPT_INPUT_ERROR)
         return vf_fail(VF_EINPUT, "%s", f.error);
     if (exit_code == SCRIPT_SETUP_ERROR)
@@ -214,15 +216,19 @@ vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
     if (exit_code != 0) {
         const char *why = f.error[0] ? f.error : f.exception;
         if (exit_code < 0)
-            return vf_fail(VF_EINTERNAL, "Blender crashed (%s) rendering %s; see %s",
-                           strsignal(sig), job->model, log_path);
-        return vf_fail(VF_EINTERNAL, "Blender failed (exit %d) rendering %s%s%s; see %s",
-                       exit_code, job->model, why[0] ? ": " : "", why, log_path);
+            return vf_keep_failure_log(log_path, "Blender",
+                                       vf_fail(VF_EINTERNAL, "Blender crashed (%s) rendering %s",
+                                               strsignal(sig), job->model));
+        return vf_keep_failure_log(log_path, "Blender",
+                                   vf_fail(VF_EINTERNAL, "Blender failed (exit %d) rendering %s%s%s",
+                                           exit_code, job->model, why[0] ? ": " : "", why));
     }
     int missing = count_missing(job);
     if (missing)
-        return vf_fail(VF_EINTERNAL, "Blender finished but %d of %d views of %s are missing; see %s",
-                       missing, job->count, job->model, log_path);
+        return vf_keep_failure_log(
+            log_path, "Blender",
+            vf_fail(VF_EINTERNAL, "Blender finished but %d of %d views of %s are missing", missing,
+                    job->count, job->model));
     if (fit && (status = vf_json_load(info_path, fit)) != VF_OK)
         return status;
     return VF_OK;
@@ -260,8 +266,9 @@ static vf_status live_gone(vf_object3d_live *live, const char *doing)
     last_error(live->log_path, why, sizeof why);
     if (code == SCRIPT_INPUT_ERROR)
         return vf_fail(VF_EINPUT, "%s", why);
-    return vf_fail(VF_EINTERNAL, "Blender stopped while %s %s (exit %d)%s%s; see %s", doing,
-                   live->model, code, why[0] ? ": " : "", why, live->log_path);
+    return vf_keep_failure_log(live->log_path, "Blender",
+                               vf_fail(VF_EINTERNAL, "Blender stopped while %s %s (exit %d)%s%s",
+                                       doing, live->model, code, why[0] ? ": " : "", why));
 }
 
 /* One line from Blender (without its newline), waiting at most timeout_s. */
@@ -275,8 +282,10 @@ static vf_status live_read_line(vf_object3d_live *live, char *out, size_t size, 
         if (ready < 0 && errno == EINTR)
             continue;
         if (ready == 0)
-            return vf_fail(VF_EINTERNAL, "Blender did not answer in %d s while %s %s; see %s",
-                           timeout_s, doing, live->model, live->log_path);
+            return vf_keep_failure_log(
+                live->log_path, "Blender",
+                vf_fail(VF_EINTERNAL, "Blender did not answer in %d s while %s %s", timeout_s,
+                        doing, live->model));
         char c;
         ssize_t n = recv(live->channel, &c, 1, 0);
         if (n < 0 && errno == EINTR)

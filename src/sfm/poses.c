@@ -5,7 +5,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include "poses_internal.h"
@@ -397,28 +396,6 @@ static vf_status run_stage(poses_run *run, const vf_workspace *ws, json_t **summ
     return status;
 }
 
-/* A failed run's COLMAP log would go with the staging folder: keep a copy in $TMPDIR (or
- * /tmp) and name it at the end of the message; `status` is returned unchanged. */
-static vf_status keep_failure_log(const poses_run *run, vf_status status)
-{
-    struct stat info;
-    if (!run->colmap.log_path[0] || stat(run->colmap.log_path, &info) != 0 || info.st_size == 0)
-        return status; /* no log, or COLMAP never ran */
-    const char *tmp = getenv("TMPDIR");
-    char copy[VF_PATH_MAX], message[1024];
-    snprintf(copy, sizeof copy, "%s/vfcapture-poses-XXXXXX.log", tmp && *tmp ? tmp : "/tmp");
-    int fd = mkstemps(copy, 4);
-    if (fd < 0)
-        return status;
-    close(fd);
-    snprintf(message, sizeof message, "%s", vf_error_message());
-    if (vf_copy_file(run->colmap.log_path, copy) == VF_OK)
-        vf_fail(status, "%s (COLMAP's log: %s)", message, copy);
-    else
-        unlink(copy);
-    return status;
-}
-
 vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **summary)
 {
     *summary = NULL;
@@ -444,7 +421,7 @@ vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **sum
                       opt.has_intrinsics, "check", opt.check);
         status = vf_stage_commit(&run.stage, params, json_deep_copy(*summary));
     } else {
-        status = keep_failure_log(&run, status);
+        status = vf_keep_failure_log(run.colmap.log_path, "COLMAP", status);
         vf_stage_abort(&run.stage);
     }
     if (status != VF_OK) {
