@@ -172,6 +172,7 @@ static void apply_setting(vf_field_train_options *o, const char *text)
     else if (!strcmp(name, "lr_color")) o->lr_color = (float)v;
     else if (!strcmp(name, "tv_density")) o->tv_density = (float)v;
     else if (!strcmp(name, "tv_color")) o->tv_color = (float)v;
+    else if (!strcmp(name, "tv_view")) o->tv_view = (float)v;
     else if (!strcmp(name, "opaque")) o->opaque = (float)v;
     else if (!strcmp(name, "step_ratio")) o->step_ratio = (float)v;
     else if (!strcmp(name, "prune_alpha")) o->prune_alpha = (float)v;
@@ -179,6 +180,7 @@ static void apply_setting(vf_field_train_options *o, const char *text)
     else if (!strcmp(name, "background_scale")) o->background_scale = (float)v;
     else if (!strcmp(name, "carve_share")) o->carve_share = (float)v;
     else if (!strcmp(name, "surroundings")) o->surroundings = (vf_field_surroundings)v;
+    else if (!strcmp(name, "color")) o->color = (vf_field_color)v;
     else if (!strcmp(name, "steps")) { o->steps = (int)v; o->seconds = 0; }
     else if (!strcmp(name, "seed")) o->seed = (uint64_t)v;
     else {

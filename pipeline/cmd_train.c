@@ -6,7 +6,7 @@
 
 static const char usage[] =
     "usage: vfcapture train WS [--minutes M | --steps N] [--holdout N] [--surroundings MODE]\n"
-    "                      [--object-only] [--restart]\n"
+    "                      [--color MODEL] [--view-smoothing W] [--object-only] [--restart]\n"
     "\n"
     "Fit a radiance field (an explicit density + spherical-harmonics grid, coarse to fine) to\n"
     "the posed images of WS: the undistorted frames of the poses stage, or an imported posed\n"
@@ -22,6 +22,13 @@ static const char usage[] =
     "      --surroundings MODE  what lies beyond the box the cameras look at: auto (a coarser\n"
     "                         outer grid for opaque photos, none for background-removed ones;\n"
     "                         the default), grid, or none (the box must explain everything)\n"
+    "      --color MODEL      how colour may change with the viewing direction: view\n"
+    "                         (degree-1 harmonics, smoothed: highlights and glass; the\n"
+    "                         default) or diffuse (one colour a point: matte objects)\n"
+    "      --view-smoothing W smooth the colour's direction terms in space (total variation,\n"
+    "                         0 off): stops noisy photos becoming a speckle; default 1e-4\n"
+    "                         for a workspace made from a 3D model (Blender's renders are\n"
+    "                         noisy), 0 for photos\n"
     "      --object-only      object mode: cut the object out of every photo (the poses\n"
     "                         stage's sparse points near the centre, minus the surface it\n"
     "                         stands on, seed GrabCut) and train on it alone, on white, as\n"
@@ -33,6 +40,8 @@ enum {
     OPT_STEPS,
     OPT_HOLDOUT,
     OPT_SURROUNDINGS,
+    OPT_COLOR,
+    OPT_VIEW_SMOOTHING,
     OPT_RESTART,
     OPT_OBJECT_ONLY
 };
@@ -51,6 +60,8 @@ static vf_status parse_options(int argc, char **argv, cli_train *opt)
         {"steps", required_argument, NULL, OPT_STEPS},
         {"holdout", required_argument, NULL, OPT_HOLDOUT},
         {"surroundings", required_argument, NULL, OPT_SURROUNDINGS},
+        {"color", required_argument, NULL, OPT_COLOR},
+        {"view-smoothing", required_argument, NULL, OPT_VIEW_SMOOTHING},
         {"restart", no_argument, NULL, OPT_RESTART},
         {"object-only", no_argument, NULL, OPT_OBJECT_ONLY},
         {0, 0, 0, 0},
@@ -81,6 +92,17 @@ static vf_status parse_options(int argc, char **argv, cli_train *opt)
                 return vf_fail(VF_EINPUT, "--surroundings must be auto, grid or none, not '%s'",
                                optarg);
             opt->train.surroundings = (vf_field_surroundings)mode;
+        } else if (c == OPT_COLOR) {
+            int model = vf_field_color_parse(optarg);
+            if (model < 0)
+                return vf_fail(VF_EINPUT, "--color must be view or diffuse, not '%s'",
+                               optarg);
+            opt->train.color = (vf_field_color)model;
+        } else if (c == OPT_VIEW_SMOOTHING) {
+            if (cli_parse_doubles(optarg, &opt->train.view_smoothing, 1) != 1 ||
+                !(opt->train.view_smoothing >= 0 && opt->train.view_smoothing <= 1))
+                return vf_fail(VF_EINPUT, "--view-smoothing must be a number from 0 to 1, not "
+                                          "'%s'", optarg);
         } else if (c == OPT_RESTART) {
             opt->train.restart = 1;
         } else if (c == OPT_OBJECT_ONLY) {

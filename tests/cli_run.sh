@@ -19,6 +19,8 @@ python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["held_out_
   && ok || bad "held-out PSNR after 500 steps is above 22 dB (a white image scores 14.4 dB): $(cat "$ws/train/report.json" | head -c 300)"
 python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["surroundings"] == "none" and "background-removed" in r["field"], r' "$ws/train/report.json" \
   && ok || bad "auto: no outer grid for the chair's transparent background, and the report says so"
+python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["color"] == "view" and r["view_smoothing"] == 0, r' "$ws/train/report.json" \
+  && ok || bad "the report names the colour model (view-dependent, not smoothed for photos)"
 
 expect 0 "run again" -- "$tool" run "$chair/transforms_train.json" -o "$ws" "${budget[@]}"
 [ "$(grep -c "is up to date" "$tmp/err")" -eq 4 ] && ok || bad "every stage up to date on the second run: $(cat "$tmp/err")"
@@ -57,6 +59,10 @@ expect 1 "train: bad --minutes" -- "$tool" train "$ws" --minutes -1
 one_line_naming "train: bad --minutes" "--minutes"
 expect 1 "train: unknown surroundings" -- "$tool" train "$ws" --surroundings room
 one_line_naming "train: unknown surroundings" "--surroundings"
+expect 1 "train: unknown colour model" -- "$tool" train "$ws" --color shiny
+one_line_naming "train: unknown colour model" "--color"
+expect 1 "train: bad smoothing" -- "$tool" train "$ws" --view-smoothing -2
+one_line_naming "train: bad smoothing" "--view-smoothing"
 expect 1 "render: malformed viewpoint" -- "$tool" render "$ws" --viewpoint 1,2,3 -o "$tmp/x.png"
 one_line_naming "render: malformed viewpoint" "--viewpoint"
 expect 1 "eval: missing test set" -- "$tool" eval "$ws" --transforms "$tmp/none.json"

@@ -108,6 +108,11 @@ int main(void)
     printf("field of the model: held-out PSNR %.2f dB\n", psnr);
     CHECK(psnr > 26, "held-out PSNR %.2f dB, wanted above 26", psnr);
     json_decref(eval);
+    json_t *report = load(ws, "train/report.json");
+    CHECK(fabs(number(report, "view_smoothing", NULL) - 1e-4) < 1e-9,
+          "a model's field smooths its colour's direction terms (view_smoothing %g)",
+          number(report, "view_smoothing", NULL));
+    json_decref(report);
 
     rc = vf_test_system("'%s' attack '%s' --label 'bell pepper' --steps 5 --samples 10 --quiet && "
                         "'%s' real '%s' --fluctuation-samples 2 --natural-views 20 --quiet",

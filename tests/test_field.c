@@ -473,7 +473,7 @@ static void test_adam_small_team(void)
 #pragma omp parallel num_threads(2)
     {
 #pragma omp single
-        vf__field_adam_step(&adam, f, lr, 0, 0); /* nested: a team of one */
+        vf__field_adam_step(&adam, f, lr, 0, 0, 0); /* nested: a team of one */
     }
     CHECK(f->grids[0].values[a * FIELD_CH] < before_a - 0.05f, "sink 0 applied");
     CHECK(f->grids[0].values[b * FIELD_CH] < before_b - 0.05f, "sink 1 applied by a team of one");
@@ -559,6 +559,55 @@ static void test_checkpoint_resume(void)
     vf_field_free(truth);
 }
 
+/* Colour models: a diffuse field never moves its degree-1 harmonics off zero, a view-dependent
+ * one does; a checkpoint made with another model is refused naming it. */
+static void test_color_models(void)
+{
+    vf_field *truth = make_field();
+    vf_field_train_options opt;
+    vf_field_train_defaults(&opt);
+    opt.seconds = 0;
+    opt.steps = 20;
+    opt.batch_rays = 256;
+    opt.max_points = 16 * 16 * 16;
+    opt.levels = 1;
+    opt.threads = 2;
+    char ckpt[512];
+    snprintf(ckpt, sizeof ckpt, "%s/color.ckpt", vf_test_tmpdir());
+    CHECK(opt.color == VF_COLOR_VIEW && opt.tv_view == 0, "default: view-dependent, unsmoothed");
+    opt.tv_view = 1e-4f; /* the smoothing a 3D model gets must not stop the view terms */
+    for (int diffuse = 0; diffuse < 2; diffuse++) {
+        opt.color = diffuse ? VF_COLOR_DIFFUSE : VF_COLOR_VIEW;
+        vf_field_trainer *t = NULL;
+        CHECK(vf_field_trainer_create(&opt, &t) == VF_OK, "create");
+        add_views(t, truth, 12);
+        CHECK(vf_field_trainer_start(t) == VF_OK, "start: %s", vf_error_message());
+        vf_field_train_status st = {0};
+        while (!st.done)
+            vf_field_trainer_step(t, &st);
+        const field_grid *g = &vf_field_trainer_field(t)->grids[0];
+        double constant = 0, degree1 = 0;
+        for (size_t i = 0; i < g->points; i++)
+            for (int ch = FIELD_CH_SH; ch < FIELD_CH_USED; ch++)
+                *((ch - FIELD_CH_SH) % 4 ? &degree1 : &constant) +=
+                    fabs(g->values[i * FIELD_CH + ch]);
+        CHECK(constant > 0 && (diffuse ? degree1 == 0 : degree1 > 0),
+              "%s: constant terms %g, degree-1 terms %g", vf_field_color_name(opt.color), constant,
+              degree1);
+        if (!diffuse)
+            CHECK(vf_field_trainer_save_checkpoint(t, ckpt) == VF_OK, "checkpoint");
+        vf_field_trainer_free(t);
+    }
+    vf_field_trainer *other = NULL;
+    vf_field_trainer_create(&opt, &other); /* diffuse, on a checkpoint of view */
+    add_views(other, truth, 12);
+    CHECK(vf_field_trainer_resume(other, ckpt) == VF_EINPUT &&
+              strstr(vf_error_message(), "--color view"),
+          "a checkpoint of another colour model refused: %s", vf_error_message());
+    vf_field_trainer_free(other);
+    vf_field_free(truth);
+}
+
 /* The empty-space radius of every cell is its Chebyshev distance to the nearest occupied
  * cell (brute force over a 40 x 30 x 20 grid with two occupied cells), capped. */
 static void test_empty_radius(void)
@@ -609,5 +658,6 @@ int main(int argc, char **argv)
     CHECK_CASE(test_hostile_models);
     CHECK_CASE(test_adam_small_team);
     CHECK_CASE(test_checkpoint_resume);
+    CHECK_CASE(test_color_models);
     return check_finish();
 }

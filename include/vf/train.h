@@ -13,8 +13,8 @@
  * trainer (vf/field.h) checkpoints into the staging folder every 30 s; a later run resumes
  * from that checkpoint unless `restart` is set, and the checkpoint goes only once the stage is
  * committed. Output: WS/train/model.vff (VF_FIELD_FILE), report.json (mode "scene" or
- * "object", views, held_out_views, steps, seconds, surroundings, field, grid, bytes,
- * held_out_psnr/ssim, held_out [per view]), held_out.jpg. */
+ * "object", views, held_out_views, steps, seconds, surroundings, color, view_smoothing, field,
+ * grid, bytes, held_out_psnr/ssim, held_out [per view]), held_out.jpg. */
 #ifndef VF_TRAIN_H
 #define VF_TRAIN_H
 
@@ -33,6 +33,10 @@ typedef struct vf_train_options {
     int steps;      /* > 0: this many optimizer steps instead of minutes */
     int holdout;    /* hold out every holdout-th view for scoring; 0 none (10) */
     vf_field_surroundings surroundings; /* VF_SURROUNDINGS_AUTO, see vf/field.h */
+    vf_field_color color;               /* VF_COLOR_VIEW, see vf/field.h */
+    double view_smoothing; /* the field's tv_view (vf/field.h); < 0: automatic (-1): 1e-4 for a
+                              workspace made from a 3D model, whose Blender renders carry
+                              Monte-Carlo noise, 0 for photos */
     int restart;                        /* ignore a checkpoint of an interrupted run */
     /* Object mode (vf/cutout.h): cut the object out of every photo with the help of the
      * poses stage's sparse points and train on it alone, on white, as on background-removed

@@ -69,8 +69,9 @@ size_t vf__field_adam_touched(const field_adam *adam)
 }
 
 /* Total-variation gradient at point i: the derivative of the mean over channels of
- * sum over the 3 forward neighbour differences squared, taken at i (its 6 edges). */
-static void add_tv(const field_grid *g, size_t i, float tv_density, float tv_color,
+ * sum over the 3 forward neighbour differences squared, taken at i (its 6 edges). The
+ * degree-1 harmonics get tv_view on top of tv_color. */
+static void add_tv(const field_grid *g, size_t i, float tv_density, float tv_color, float tv_view,
                    float grad[FIELD_CH])
 {
     const size_t stride[3] = {1, (size_t)g->dim[0], (size_t)g->dim[0] * g->dim[1]};
@@ -91,8 +92,8 @@ static void add_tv(const field_grid *g, size_t i, float tv_density, float tv_col
         }
     }
     grad[FIELD_CH_DENSITY] += 2.0f * tv_density * diff[FIELD_CH_DENSITY];
-    for (int ch = FIELD_CH_SH; ch < FIELD_CH_USED; ch++)
-        grad[ch] += 2.0f * tv_color * diff[ch];
+    for (int ch = FIELD_CH_SH; ch < FIELD_CH_USED; ch++) /* basis 0 is the constant */
+        grad[ch] += 2.0f * (tv_color + ((ch - FIELD_CH_SH) % 4 ? tv_view : 0.0f)) * diff[ch];
 }
 
 /* Lowest thread whose sink touched point i of grid g. */
@@ -116,7 +117,7 @@ static inline void adam_update(float *p, float *m, float *v, const float *grad,
 }
 
 void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
-                         float tv_color)
+                         float tv_color, float tv_view)
 {
     adam->t++;
     const float bc1 = 1.0f - powf(adam->beta1, (float)adam->t);
@@ -126,7 +127,7 @@ void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH]
     for (int ch = 0; ch < FIELD_CH; ch++)
         step_size[ch] = lr[ch] * sqrtf(bc2) / bc1;
     const float eps_hat = adam->eps * sqrtf(bc2);
-    const int use_tv = tv_density > 0 || tv_color > 0;
+    const int use_tv = tv_density > 0 || tv_color > 0 || tv_view > 0;
     const int threads = adam->threads;
 
     /* One sink per training thread. The team here may be smaller than `threads` (OpenMP may
@@ -152,7 +153,7 @@ void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH]
                                 total[ch] += other[ch];
                         }
                     if (use_tv)
-                        add_tv(grid, i, tv_density, tv_color, total);
+                        add_tv(grid, i, tv_density, tv_color, tv_view, total);
                 }
             }
 #pragma omp barrier

@@ -26,7 +26,7 @@
 #define MODEL_MAGIC "VFFIELD\n"
 #define MODEL_VERSION 1u
 #define CHECKPOINT_MAGIC "VFCKPT\n"
-#define CHECKPOINT_VERSION 2u /* 2: surroundings model replaced keep_background */
+#define CHECKPOINT_VERSION 3u /* 2: surroundings model replaced keep_background; 3: colour model */
 
 /* ---- a file with a running checksum ------------------------------------------------------ */
 
@@ -447,17 +447,18 @@ vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
         else if (st.fingerprint != vf__trainer_views_fingerprint(t))
             status = vf_fail(VF_EINPUT, "%s was made from other training images or poses", path);
         else if (st.options.seconds != t->opt.seconds || st.options.steps != t->opt.steps ||
-                 st.options.surroundings != t->opt.surroundings)
+                 st.options.surroundings != t->opt.surroundings || st.options.color != t->opt.color)
             /* the schedule (upsampling, pruning) is laid out over the budget: refuse a new one
              * rather than silently keep the old, so what ran is what the user asked */
             status =
                 vf_fail(VF_EINPUT,
                         "the interrupted training in %s ran with a budget of "
-                        "%g%s and --surroundings %s; give the same to continue it, or "
-                        "--restart",
+                        "%g%s, --surroundings %s and --color %s; give the same to continue it, "
+                        "or --restart",
                         path, st.options.seconds > 0 ? st.options.seconds / 60 : st.options.steps,
                         st.options.seconds > 0 ? " minutes" : " steps",
-                        vf_field_surroundings_name(st.options.surroundings));
+                        vf_field_surroundings_name(st.options.surroundings),
+                        vf_field_color_name(st.options.color));
     }
     vf_field *f = NULL;
     if (status == VF_OK)

@@ -10,15 +10,20 @@
 #include "vf/dataset.h"
 #include "vf/log.h"
 #include "vf/metrics.h"
+#include "vf/object3d.h"
 #include "vf/plot.h"
 
 #define CHECKPOINT_SECONDS 30.0
 #define CHECKPOINT_FILE "checkpoint.vfc"
 #define OBJECT_CARVE_SHARE 0.25f
+/* The smoothing of the colour's direction terms for a 3D model's renders (vf/field.h tv_view:
+ * their Monte-Carlo noise would become speckle; clean photos lose detail with it). */
+#define MODEL_VIEW_SMOOTHING 1e-4f
 
 void vf_train_defaults(vf_train_options *o)
 {
-    *o = (vf_train_options){.minutes = 3, .holdout = 10, .surroundings = VF_SURROUNDINGS_AUTO};
+    *o = (vf_train_options){.minutes = 3, .holdout = 10, .surroundings = VF_SURROUNDINGS_AUTO,
+                            .color = VF_COLOR_VIEW, .view_smoothing = -1};
 }
 
 vf_status vf_train_options_check(const vf_train_options *o)
@@ -226,6 +231,13 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
     if (opt->steps)
         topt.steps = opt->steps;
     topt.surroundings = opt->surroundings;
+    topt.color = opt->color;
+    vf_object3d made_from;
+    if (opt->view_smoothing >= 0)
+        topt.tv_view = (float)opt->view_smoothing;
+    else
+        topt.tv_view = vf_object3d_load(ws, &made_from) == VF_OK ? MODEL_VIEW_SMOOTHING : 0.0f;
+    vf_error_clear();
     if (opt->object_only) /* a cut-out errs in a view or two: the hull keeps what most see */
         topt.carve_share = OBJECT_CARVE_SHARE;
     vf_field_trainer *t = NULL;
@@ -295,13 +307,17 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                            : with_alpha             ? "object box (background-removed photos)"
                                                     : "object box only";
         json_object_update_new(report,
-                               json_pack("{s:i, s:i, s:i, s:f, s:s, s:s, s:[i,i,i], s:I}", "views",
-                                         views.count - held, "held_out_views", held, "steps",
-                                         st.step, "seconds", st.elapsed, "surroundings",
-                                         info.has_background_grid ? "grid" : "none", "field", kind,
+                               json_pack("{s:i, s:i, s:i, s:f, s:s, s:s, s:f, s:s, s:[i,i,i], s:I}",
+                                         "views", views.count - held, "held_out_views", held,
+                                         "steps", st.step, "seconds", st.elapsed, "surroundings",
+                                         info.has_background_grid ? "grid" : "none", "color",
+                                         vf_field_color_name(opt->color), "view_smoothing",
+                                         (double)topt.tv_view, "field",
+                                         kind,
                                          "grid", info.dim[0], info.dim[1], info.dim[2], "bytes",
                                          (json_int_t)info.bytes));
-        vf_info("field: %s", kind);
+        vf_info("field: %s, %s colour", kind,
+                opt->color == VF_COLOR_DIFFUSE ? "diffuse" : "view-dependent");
         if (held)
             json_object_update_new(
                 report, json_pack("{s:f, s:f}", "held_out_psnr", psnr, "held_out_ssim", ssim));
@@ -322,11 +338,12 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                                        ssim, "steps", st.step)
                            : json_pack("{s:i}", "steps", st.step);
     status = vf_stage_commit(&stage,
-                             json_pack("{s:f, s:i, s:i, s:s, s:b}", "minutes", opt->minutes,
-                                       "steps", opt->steps, "holdout", opt->holdout,
+                             json_pack("{s:f, s:i, s:i, s:s, s:s, s:f, s:b}", "minutes",
+                                       opt->minutes, "steps", opt->steps, "holdout", opt->holdout,
                                        "surroundings",
-                                       vf_field_surroundings_name(opt->surroundings),
-                                       "object_only", opt->object_only),
+                                       vf_field_surroundings_name(opt->surroundings), "color",
+                                       vf_field_color_name(opt->color), "view_smoothing",
+                                       (double)topt.tv_view, "object_only", opt->object_only),
                              json_incref(summary));
     /* The checkpoint goes only once the stage is in place: after a failed commit the next run
      * resumes from it at its end instead of training again. */

@@ -21,6 +21,7 @@ void vf_field_train_defaults(vf_field_train_options *opt)
     opt->upsample_end = 0.3;
     opt->background[0] = opt->background[1] = opt->background[2] = 1.0f;
     opt->surroundings = VF_SURROUNDINGS_AUTO;
+    opt->color = VF_COLOR_VIEW;
     opt->background_scale = 4.0f;
     opt->box_scale = 0;
     opt->step_ratio = 0;
@@ -28,6 +29,7 @@ void vf_field_train_defaults(vf_field_train_options *opt)
     opt->lr_color = 0.05f;
     opt->tv_density = 0;
     opt->tv_color = 0;
+    opt->tv_view = 0;
     opt->opaque = 0.1f;
     opt->prune_alpha = 0.1f;
     opt->seed = 1;
@@ -46,6 +48,10 @@ static vf_status check_options(const vf_field_train_options *o)
         return vf_fail(VF_EINPUT, "levels must be 1..8");
     if ((unsigned)o->surroundings > VF_SURROUNDINGS_NONE)
         return vf_fail(VF_EINPUT, "unknown surroundings model %d", (int)o->surroundings);
+    if (!(o->tv_view >= 0 && o->tv_view <= 1))
+        return vf_fail(VF_EINPUT, "view-dependence smoothing %g is out of range", o->tv_view);
+    if ((unsigned)o->color > VF_COLOR_DIFFUSE)
+        return vf_fail(VF_EINPUT, "unknown colour model %d", (int)o->color);
     if (o->step_ratio != 0 && !(o->step_ratio >= 0.1f && o->step_ratio <= 2.0f))
         return vf_fail(VF_EINPUT, "step ratio %g is out of range (0.1 to 2 voxels)",
                        o->step_ratio);
@@ -351,10 +357,12 @@ vf_status vf_field_trainer_step(vf_field_trainer *t, vf_field_train_status *stat
     float decay = (float)pow(0.1, fraction);
     float lr[FIELD_CH] = {0};
     lr[FIELD_CH_DENSITY] = t->opt.lr_density * decay;
+    /* a diffuse field never moves its degree-1 terms off zero (basis b = 0 is the constant) */
+    const int diffuse = t->opt.color == VF_COLOR_DIFFUSE;
     for (int ch = FIELD_CH_SH; ch < FIELD_CH_USED; ch++)
-        lr[ch] = t->opt.lr_color * decay;
+        lr[ch] = diffuse && (ch - FIELD_CH_SH) % 4 ? 0.0f : t->opt.lr_color * decay;
     t->last_touched = (double)vf__field_adam_touched(&t->adam);
-    vf__field_adam_step(&t->adam, f, lr, t->opt.tv_density, t->opt.tv_color);
+    vf__field_adam_step(&t->adam, f, lr, t->opt.tv_density, t->opt.tv_color, t->opt.tv_view);
     t->last_samples_per_ray = (double)samples / rays;
     t->last_step_ms = (t1 - t0) * 1000;
     t->last_optimizer_ms = (vf_now() - t1) * 1000;

@@ -116,10 +116,11 @@ vf_status vf__field_adam_alloc(field_adam *adam, const vf_field *f, int threads)
 void vf__field_adam_free(field_adam *adam);
 
 /* Apply one Adam step to every point touched since the last step, summing the threads'
- * gradients (plus total variation when weights are non-zero), then clear the sinks.
+ * gradients (plus total variation when weights are non-zero: tv_view on the degree-1
+ * harmonics alone), then clear the sinks.
  * lr[ch] is the learning rate of channel ch. */
 void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
-                         float tv_color);
+                         float tv_color, float tv_view);
 
 /* Number of distinct points touched (for statistics). */
 size_t vf__field_adam_touched(const field_adam *adam);
