@@ -312,10 +312,8 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                                          "steps", st.step, "seconds", st.elapsed, "surroundings",
                                          info.has_background_grid ? "grid" : "none", "color",
                                          vf_field_color_name(opt->color), "view_smoothing",
-                                         (double)topt.tv_view, "field",
-                                         kind,
-                                         "grid", info.dim[0], info.dim[1], info.dim[2], "bytes",
-                                         (json_int_t)info.bytes));
+                                         (double)topt.tv_view, "field", kind, "grid", info.dim[0],
+                                         info.dim[1], info.dim[2], "bytes", (json_int_t)info.bytes));
         vf_info("field: %s, %s colour", kind,
                 opt->color == VF_COLOR_DIFFUSE ? "diffuse" : "view-dependent");
         if (held)
