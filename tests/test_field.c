@@ -497,17 +497,24 @@ static void add_views(vf_field_trainer *t, const vf_field *f, int count)
     }
 }
 
-static void test_checkpoint_resume(void)
+/* The defaults, on a small budget: `steps` steps of 256 rays over a 16^3 grid, 2 threads. */
+static vf_field_train_options small_training(int steps, int levels)
 {
-    vf_field *truth = make_field();
     vf_field_train_options opt;
     vf_field_train_defaults(&opt);
     opt.seconds = 0;
-    opt.steps = 40;
+    opt.steps = steps;
     opt.batch_rays = 256;
     opt.max_points = 16 * 16 * 16;
-    opt.levels = 2;
+    opt.levels = levels;
     opt.threads = 2;
+    return opt;
+}
+
+static void test_checkpoint_resume(void)
+{
+    vf_field *truth = make_field();
+    vf_field_train_options opt = small_training(40, 2);
     char ckpt[512];
     snprintf(ckpt, sizeof ckpt, "%s/train.ckpt", vf_test_tmpdir());
 
@@ -564,14 +571,7 @@ static void test_checkpoint_resume(void)
 static void test_color_models(void)
 {
     vf_field *truth = make_field();
-    vf_field_train_options opt;
-    vf_field_train_defaults(&opt);
-    opt.seconds = 0;
-    opt.steps = 20;
-    opt.batch_rays = 256;
-    opt.max_points = 16 * 16 * 16;
-    opt.levels = 1;
-    opt.threads = 2;
+    vf_field_train_options opt = small_training(20, 1);
     char ckpt[512];
     snprintf(ckpt, sizeof ckpt, "%s/color.ckpt", vf_test_tmpdir());
     CHECK(opt.color == VF_COLOR_VIEW && opt.tv_view == 0, "default: view-dependent, unsmoothed");
