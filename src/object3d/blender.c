@@ -203,32 +203,29 @@ vf_status vf__blender_render(const vf__blender_job *job, json_t **fit)
         return status;
 
     if (timed_out) /* a model that hangs the importer or the renderer must not hang us */
-        return vf_keep_failure_log(
-            log_path, "Blender",
-            vf_fail(VF_EINPUT,
-                    "Blender printed nothing for %d s rendering %s and was stopped "
-                    "(VF_BLENDER_TIMEOUT sets the limit)",
-                    silent_s, job->model));
-    if (exit_code == SCRIPT_INPUT_ERROR)
+        status = vf_fail(VF_EINPUT,
+                         "Blender printed nothing for %d s rendering %s and was stopped "
+                         "(VF_BLENDER_TIMEOUT sets the limit)",
+                         silent_s, job->model);
+    else if (exit_code == SCRIPT_INPUT_ERROR) /* the script's own line says it all */
         return vf_fail(VF_EINPUT, "%s", f.error);
-    if (exit_code == SCRIPT_SETUP_ERROR)
-        return vf_fail(VF_EINTERNAL, "%s", f.error);
-    if (exit_code != 0) {
+    else if (exit_code == SCRIPT_SETUP_ERROR)
+        status = vf_fail(VF_EINTERNAL, "%s", f.error);
+    else if (exit_code < 0)
+        status = vf_fail(VF_EINTERNAL, "Blender crashed (%s) rendering %s", strsignal(sig),
+                         job->model);
+    else if (exit_code != 0) {
         const char *why = f.error[0] ? f.error : f.exception;
-        if (exit_code < 0)
-            return vf_keep_failure_log(log_path, "Blender",
-                                       vf_fail(VF_EINTERNAL, "Blender crashed (%s) rendering %s",
-                                               strsignal(sig), job->model));
-        return vf_keep_failure_log(log_path, "Blender",
-                                   vf_fail(VF_EINTERNAL, "Blender failed (exit %d) rendering %s%s%s",
-                                           exit_code, job->model, why[0] ? ": " : "", why));
+        status = vf_fail(VF_EINTERNAL, "Blender failed (exit %d) rendering %s%s%s", exit_code,
+                         job->model, why[0] ? ": " : "", why);
+    } else {
+        int missing = count_missing(job);
+        if (missing)
+            status = vf_fail(VF_EINTERNAL, "Blender finished but %d of %d views of %s are missing",
+                             missing, job->count, job->model);
     }
-    int missing = count_missing(job);
-    if (missing)
-        return vf_keep_failure_log(
-            log_path, "Blender",
-            vf_fail(VF_EINTERNAL, "Blender finished but %d of %d views of %s are missing", missing,
-                    job->count, job->model));
+    if (status != VF_OK) /* the log would go with a removed staging folder */
+        return vf_keep_failure_log(log_path, "Blender", status);
     if (fit && (status = vf_json_load(info_path, fit)) != VF_OK)
         return status;
     return VF_OK;
