@@ -31,6 +31,7 @@
 #include "vf/classifier.h"
 #include "vf/dataset.h"
 #include "vf/field.h"
+#include "vf/fsutil.h"
 #include "vf/image.h"
 #include "vf/log.h"
 #include "vf/metrics.h"
@@ -424,6 +425,10 @@ int main(int argc, char **argv)
                     "[--save PATH] [--dump DIR]\n");
             return 1;
         }
+    }
+    if (dump_dir && vf_mkdirs(dump_dir) != VF_OK) {
+        fprintf(stderr, "bench_field: %s\n", vf_error_message());
+        return 1;
     }
     if (!want_chair && !want_lego && !want_fox && !want_render && !capture_count)
         want_chair = want_lego = want_fox = want_render = 1;
