@@ -22,7 +22,7 @@ static const char usage[] =
     "  -l, --label SET      true label set, names or indices (default: the classifier's\n"
     "                       majority vote over natural views)\n"
     "  -n, --frames N       frames to keep from a video or photo folder (default 100)\n"
-    "      --minutes M      radiance-field training time (default 3)\n"
+    "      --minutes M      radiance-field training time (default 3; 5 for a 3D model)\n"
     "      --train-steps N  train for N steps instead (the same field on a busy machine)\n"
     "      --object-only    object mode: train on the object cut out of the photos (see\n"
     "                       'vfcapture train --help')\n"

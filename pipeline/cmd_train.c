@@ -15,7 +15,7 @@ static const char usage[] =
     "photos beside their renders).\n"
     "\n"
     "options:\n"
-    "      --minutes M        training wall time (default 3)\n"
+    "      --minutes M        training wall time (default 3; 5 for a 3D model's workspace)\n"
     "      --steps N          train for N optimizer steps instead of a time (the same field\n"
     "                         however busy the machine is)\n"
     "      --holdout N        hold out every Nth view for scoring, 0 for none (default 10)\n"

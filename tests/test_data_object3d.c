@@ -24,6 +24,7 @@
 #include "vf/fsutil.h"
 #include "vf/image.h"
 #include "vf/pose.h"
+#include "vf/train.h"
 
 #define MODEL "data/models_3d/bell_pepper__yellow_bell_pepper.glb"
 
@@ -113,6 +114,14 @@ int main(void)
           "a model's field smooths its colour's direction terms (view_smoothing %g)",
           number(report, "view_smoothing", NULL));
     json_decref(report);
+    /* the budget a model's workspace gets when none is given (recorded even with --steps) */
+    json_t *manifest = load(ws, "manifest.json");
+    const json_t *params = json_object_get(
+        json_object_get(json_object_get(manifest, "stages"), "train"), "params");
+    const double minutes = json_number_value(json_object_get(params, "minutes"));
+    CHECK(minutes == VF_TRAIN_MINUTES_MODEL, "a model's default budget is %g minutes, not %g",
+          VF_TRAIN_MINUTES_MODEL, minutes);
+    json_decref(manifest);
 
     rc = vf_test_system("'%s' attack '%s' --label 'bell pepper' --steps 5 --samples 10 --quiet && "
                         "'%s' real '%s' --fluctuation-samples 2 --natural-views 20 --quiet",

@@ -22,14 +22,14 @@
 
 void vf_train_defaults(vf_train_options *o)
 {
-    *o = (vf_train_options){.minutes = 3, .holdout = 10, .surroundings = VF_SURROUNDINGS_AUTO,
+    *o = (vf_train_options){.minutes = 0, .holdout = 10, .surroundings = VF_SURROUNDINGS_AUTO,
                             .color = VF_COLOR_VIEW, .view_smoothing = -1};
 }
 
 vf_status vf_train_options_check(const vf_train_options *o)
 {
-    if (!o->steps && !(o->minutes > 0 && o->minutes <= 600))
-        return vf_fail(VF_EINPUT, "training time must be above 0 and at most 600 minutes, not %g",
+    if (!(o->minutes >= 0 && o->minutes <= 600))
+        return vf_fail(VF_EINPUT, "training time must be at most 600 minutes, not %g",
                        o->minutes);
     if (o->steps < 0 || o->holdout < 0 || o->holdout == 1)
         return vf_fail(VF_EINPUT, "steps must be >= 0 and holdout 0 or from 2 up");
@@ -225,19 +225,23 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                        views.count);
     }
 
+    vf_object3d made_from;
+    const int from_model = vf_object3d_load(ws, &made_from) == VF_OK;
+    vf_error_clear();
+    const double minutes = opt->minutes > 0 ? opt->minutes
+                           : from_model     ? VF_TRAIN_MINUTES_MODEL
+                                            : VF_TRAIN_MINUTES;
     vf_field_train_options topt;
     vf_field_train_defaults(&topt);
-    topt.seconds = opt->steps ? 0 : 60 * opt->minutes;
+    topt.seconds = opt->steps ? 0 : 60 * minutes;
     if (opt->steps)
         topt.steps = opt->steps;
     topt.surroundings = opt->surroundings;
     topt.color = opt->color;
-    vf_object3d made_from;
     if (opt->view_smoothing >= 0)
         topt.tv_view = (float)opt->view_smoothing;
     else
-        topt.tv_view = vf_object3d_load(ws, &made_from) == VF_OK ? MODEL_VIEW_SMOOTHING : 0.0f;
-    vf_error_clear();
+        topt.tv_view = from_model ? MODEL_VIEW_SMOOTHING : 0.0f;
     if (opt->object_only) /* a cut-out errs in a view or two: the hull keeps what most see */
         topt.carve_share = OBJECT_CARVE_SHARE;
     vf_field_trainer *t = NULL;
@@ -279,7 +283,7 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                     views.count - held, held, opt->steps);
         else
             vf_info("training on %d views (%d held out) for %.1f minutes on all cores",
-                    views.count - held, held, opt->minutes);
+                    views.count - held, held, minutes);
         status = run_training(t, checkpoint, &st);
     }
 
@@ -337,7 +341,7 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                            : json_pack("{s:i}", "steps", st.step);
     status = vf_stage_commit(&stage,
                              json_pack("{s:f, s:i, s:i, s:s, s:s, s:f, s:b}", "minutes",
-                                       opt->minutes, "steps", opt->steps, "holdout", opt->holdout,
+                                       minutes, "steps", opt->steps, "holdout", opt->holdout,
                                        "surroundings",
                                        vf_field_surroundings_name(opt->surroundings), "color",
                                        vf_field_color_name(opt->color), "view_smoothing",
