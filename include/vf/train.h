@@ -56,6 +56,10 @@ typedef struct vf_train_options {
 
 void vf_train_defaults(vf_train_options *o);
 
+/* The wall-time budget a training gets: o->minutes when set, else the default for photos or,
+ * when from_model, for a 3D model's renders. */
+double vf_train_minutes(const vf_train_options *o, int from_model);
+
 /* VF_EINPUT naming the option that cannot run (minutes outside (0, 600], holdout 1). */
 vf_status vf_train_options_check(const vf_train_options *o);
 

@@ -26,6 +26,11 @@ void vf_train_defaults(vf_train_options *o)
                             .color = VF_COLOR_VIEW, .view_smoothing = -1};
 }
 
+double vf_train_minutes(const vf_train_options *o, int from_model)
+{
+    return o->minutes > 0 ? o->minutes : from_model ? VF_TRAIN_MINUTES_MODEL : VF_TRAIN_MINUTES;
+}
+
 vf_status vf_train_options_check(const vf_train_options *o)
 {
     if (!(o->minutes >= 0 && o->minutes <= 600))
@@ -228,9 +233,7 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
     vf_object3d made_from;
     const int from_model = vf_object3d_load(ws, &made_from) == VF_OK;
     vf_error_clear();
-    const double minutes = opt->minutes > 0 ? opt->minutes
-                           : from_model     ? VF_TRAIN_MINUTES_MODEL
-                                            : VF_TRAIN_MINUTES;
+    const double minutes = vf_train_minutes(opt, from_model);
     vf_field_train_options topt;
     vf_field_train_defaults(&topt);
     topt.seconds = opt->steps ? 0 : 60 * minutes;

@@ -58,10 +58,7 @@ static int plan_stages(const vf_run_options *o, stage_call *calls)
         calls[n++] = (stage_call){"poses", POSES, json_object()};
     calls[n++] = (stage_call){
         "train", TRAIN,
-        json_pack("{s:f, s:i}", "minutes",
-                  o->train.minutes > 0      ? o->train.minutes
-                  : kind == VF_INGEST_MODEL ? VF_TRAIN_MINUTES_MODEL
-                                            : VF_TRAIN_MINUTES,
+        json_pack("{s:f, s:i}", "minutes", vf_train_minutes(&o->train, kind == VF_INGEST_MODEL),
                   "steps", o->train.steps)};
     if (o->train.object_only) /* the key only when set: older workspaces stay current */
         json_object_set_new(calls[n - 1].settings, "object_only", json_true());
