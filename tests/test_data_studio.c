@@ -1,5 +1,5 @@
 /* The physical loop in the simulated studio (vf/studio.h), short and small: the water bottle of
- * models_3d filmed handheld around it (270x480 at 15 fps, two loops of 3 s, so a shutter of a
+ * models_3d filmed handheld around it (270x480 at 15 fps, two loops of 2 s, so a shutter of a
  * tenth of the frame interval: the blur of a 1/60 s shutter at a walking pace), the video
  * through ingest and poses, a hand-made attack whose v* is the viewpoint of a registered
  * frame, export, the studio's re-shoot at target 0, then `reshoot --video` and `score` on that
@@ -33,6 +33,8 @@
 #include "vf/pose.h"
 
 #define MODEL "data/models_3d/water_bottle__WaterBottle.glb"
+#define FPS 15
+#define LOOP_SECONDS 2 /* two loops: 60 frames, of which ingest keeps 50 */
 #define TOLERANCE 0.15 /* score's box: +-15% of each parameter's range; the person wanders
                           * 3% around v* and the hand shakes the position by 1% of the
                           * distance: most frames on target are well inside */
@@ -97,8 +99,8 @@ static double check_capture_poses(const char *ws, const json_t *truth)
     return ingested ? (double)n / ingested : 0;
 }
 
-/* v* = the viewpoint of the registered frame nearest video frame 15, a third of the way round
- * the first loop (45 frames): the re-shoot walks there from the capture's start, out of the
+/* v* = the viewpoint of the registered frame nearest a third of the way round the first loop
+ * (video frame 10 of 30): the re-shoot walks there from the capture's start, out of the
  * box and into it, whichever frames COLMAP registered (the middle registered frame was near
  * the start when the second loop's frames registered, and the split vanished). */
 static void write_attack(const char *ws, vf_viewpoint *v_star)
@@ -113,10 +115,10 @@ static void write_attack(const char *ws, vf_viewpoint *v_star)
     vf_viewpoint *samples = malloc(sizeof *samples * (size_t)ds.count);
     for (int i = 0; i < ds.count; i++)
         vf_c2w_to_viewpoint(ds.frames[i].c2w, &samples[i]);
-    int nearest = 0;
+    int nearest = 0, third = FPS * LOOP_SECONDS / 3;
     for (int i = 1; i < ds.count; i++)
-        if (abs(frame_index(ds.frames[i].image_path) - 15) <
-            abs(frame_index(ds.frames[nearest].image_path) - 15))
+        if (abs(frame_index(ds.frames[i].image_path) - third) <
+            abs(frame_index(ds.frames[nearest].image_path) - third))
             nearest = i;
     *v_star = samples[nearest];
     test_label_set bottle = {1, {898}, {"water bottle"}};
@@ -266,9 +268,9 @@ int main(int argc, char **argv)
     double start = vf_now();
     int rc = vf_is_file(capture)
                  ? 0
-                 : vf_test_system("'%s' simulate capture '%s' -o '%s' --size 270x480 --fps 15 --shutter 0.1 "
-                                  "--loop-seconds 3 -q",
-                                  tool(), vf_test_shared(MODEL), capture);
+                 : vf_test_system("'%s' simulate capture '%s' -o '%s' --size 270x480 --fps %d "
+                                  "--shutter 0.1 --loop-seconds %d -q",
+                                  tool(), vf_test_shared(MODEL), capture, FPS, LOOP_SECONDS);
     CHECK(rc == 0, "simulate capture exit %d", rc);
     printf("simulate capture: %.0f s\n", vf_now() - start);
     start = vf_now();
@@ -280,8 +282,8 @@ int main(int argc, char **argv)
     printf("ingest and poses: %.0f s\n", vf_now() - start);
     snprintf(path, sizeof path, "%s/capture.truth.json", dir);
     json_t *truth = load_json(path);
-    CHECK(truth && json_array_size(json_object_get(truth, "frames")) == 90,
-          "the truth has a pose for each of the 90 frames");
+    CHECK(truth && json_array_size(json_object_get(truth, "frames")) == 2 * FPS * LOOP_SECONDS,
+          "the truth has a pose for each of the %d frames", 2 * FPS * LOOP_SECONDS);
     if (!truth)
         return check_finish();
     check_capture_poses(ws, truth);
@@ -292,8 +294,8 @@ int main(int argc, char **argv)
     rc = vf_test_system("'%s' export '%s' --count 2 -q >/dev/null", tool(), ws);
     CHECK(rc == 0, "export exit %d", rc);
     start = vf_now();
-    rc = vf_test_system("'%s' simulate reshoot '%s' --target 0 -o '%s' --walk-seconds 2 "
-                        "--hold-seconds 2 --jitter 3 -q",
+    rc = vf_test_system("'%s' simulate reshoot '%s' --target 0 -o '%s' --walk-seconds 1.5 "
+                        "--hold-seconds 1.5 --jitter 3 -q",
                         tool(), ws, reshoot);
     CHECK(rc == 0, "simulate reshoot exit %d", rc);
     printf("simulate reshoot: %.0f s\n", vf_now() - start);
