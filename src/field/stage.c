@@ -34,7 +34,8 @@ double vf_train_minutes(const vf_train_options *o, int from_model)
 vf_status vf_train_options_check(const vf_train_options *o)
 {
     if (!(o->minutes >= 0 && o->minutes <= 600))
-        return vf_fail(VF_EINPUT, "training time must be at most 600 minutes, not %g",
+        return vf_fail(VF_EINPUT,
+                       "training time must be 0 (the default budget) to 600 minutes, not %g",
                        o->minutes);
     if (o->steps < 0 || o->holdout < 0 || o->holdout == 1)
         return vf_fail(VF_EINPUT, "steps must be >= 0 and holdout 0 or from 2 up");
