@@ -322,6 +322,10 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                                          vf_field_color_name(opt->color), "view_smoothing",
                                          (double)topt.tv_view, "field", kind, "grid", info.dim[0],
                                          info.dim[1], info.dim[2], "bytes", (json_int_t)info.bytes));
+        /* the trainer's automatic choices for this capture (vf/field.h) */
+        const vf_field_train_options *used = vf_field_trainer_options(t);
+        json_object_set_new(report, "color_smoothing", json_real(used->tv_color));
+        json_object_set_new(report, "levels", json_integer(used->levels));
         vf_info("field: %s, %s colour", kind,
                 opt->color == VF_COLOR_DIFFUSE ? "diffuse" : "view-dependent");
         if (held)

@@ -16,8 +16,8 @@ void vf_field_train_defaults(vf_field_train_options *opt)
     opt->seconds = 180;
     opt->steps = 0;
     opt->batch_rays = 8192;
-    opt->max_points = 128.0 * 128.0 * 128.0;
-    opt->levels = 3;
+    opt->max_points = 0;
+    opt->levels = 0;
     opt->upsample_end = 0.3;
     opt->background[0] = opt->background[1] = opt->background[2] = 1.0f;
     opt->surroundings = VF_SURROUNDINGS_AUTO;
@@ -28,7 +28,7 @@ void vf_field_train_defaults(vf_field_train_options *opt)
     opt->lr_density = 0.1f;
     opt->lr_color = 0.05f;
     opt->tv_density = 0;
-    opt->tv_color = 0;
+    opt->tv_color = -1;
     opt->tv_view = 0;
     opt->opaque = 0.1f;
     opt->prune_alpha = 0.1f;
@@ -42,10 +42,12 @@ static vf_status check_options(const vf_field_train_options *o)
         return vf_fail(VF_EINPUT, "give a training time (seconds > 0) or a number of steps");
     if (o->batch_rays < 64 || o->batch_rays > (1 << 22))
         return vf_fail(VF_EINPUT, "batch of %d rays is out of range", o->batch_rays);
-    if (!(o->max_points >= 1000) || o->max_points > 1e9)
+    if (o->max_points != 0 && (!(o->max_points >= 1000) || o->max_points > 1e9))
         return vf_fail(VF_EINPUT, "grid of %g points is out of range", o->max_points);
-    if (o->levels < 1 || o->levels > 8)
-        return vf_fail(VF_EINPUT, "levels must be 1..8");
+    if (o->levels < 0 || o->levels > 8)
+        return vf_fail(VF_EINPUT, "levels must be 1..8 (or 0: automatic)");
+    if (!(o->tv_density >= 0 && o->tv_density <= 1) || !(o->tv_color <= 1))
+        return vf_fail(VF_EINPUT, "smoothing weights must be at most 1 (density: at least 0)");
     if ((unsigned)o->surroundings > VF_SURROUNDINGS_NONE)
         return vf_fail(VF_EINPUT, "unknown surroundings model %d", (int)o->surroundings);
     if (!(o->tv_view >= 0 && o->tv_view <= 1))
@@ -89,6 +91,11 @@ void vf_field_trainer_free(vf_field_trainer *t)
     free(t->scratch);
     vf_field_free(t->field);
     free(t);
+}
+
+const vf_field_train_options *vf_field_trainer_options(const vf_field_trainer *t)
+{
+    return &t->opt;
 }
 
 const vf_field *vf_field_trainer_field(const vf_field_trainer *t)
