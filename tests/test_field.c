@@ -608,6 +608,55 @@ static void test_color_models(void)
     vf_field_free(truth);
 }
 
+/* The automatic options are resolved at start from what the photos are: opaque photos (an
+ * outer grid) get the longer ramp and the colour smoothing, photos with alpha the sharp fit;
+ * values the caller gave are kept. */
+static void test_automatic_options(void)
+{
+    vf_field *truth = make_field();
+    for (int kind = 0; kind < 3; kind++) { /* opaque, with alpha, opaque with explicit values */
+        vf_field_train_options opt = small_training(3, 0);
+        CHECK(opt.levels == 0 && opt.tv_color < 0 && opt.max_points == 16 * 16 * 16,
+              "levels and colour smoothing are automatic by default");
+        if (kind == 2) {
+            opt.levels = 2;
+            opt.tv_color = 0;
+        }
+        vf_field_trainer *t = NULL;
+        CHECK(vf_field_trainer_create(&opt, &t) == VF_OK, "create: %s", vf_error_message());
+        if (kind == 1) {
+            for (int i = 0; i < 8; i++) {
+                vf_viewpoint v = {.psi = -180 + 45.0 * i, .theta = 0, .phi = 50};
+                double c2w[16];
+                vf_viewpoint_to_c2w(&v, c2w);
+                vf_image rgb = {0}, rgba = {0};
+                vf_field_render(truth, &truth->camera, c2w, &rgb);
+                vf_image_alloc(&rgba, rgb.width, rgb.height, 4);
+                for (size_t p = 0; p < (size_t)rgb.width * rgb.height; p++) {
+                    memcpy(rgba.data + 4 * p, rgb.data + 3 * p, 3 * sizeof(float));
+                    rgba.data[4 * p + 3] = 1.0f;
+                }
+                CHECK(vf_field_trainer_add_view(t, &truth->camera, c2w, &rgba) == VF_OK, "view");
+                vf_image_free(&rgb);
+                vf_image_free(&rgba);
+            }
+        } else {
+            add_views(t, truth, 8);
+        }
+        CHECK(vf_field_trainer_start(t) == VF_OK, "start: %s", vf_error_message());
+        const vf_field_train_options *used = vf_field_trainer_options(t);
+        const int outer = vf_field_trainer_field(t)->grid_count == 2;
+        const int want_levels = kind == 2 ? 2 : kind == 0 ? 6 : 3;
+        const float want_tv = kind == 0 ? 1e-4f : 0.0f;
+        CHECK(outer == (kind != 1) && used->levels == want_levels && used->tv_color == want_tv &&
+                  used->max_points == 16 * 16 * 16,
+              "case %d: outer grid %d, levels %d, colour smoothing %g, %g points", kind, outer,
+              used->levels, (double)used->tv_color, used->max_points);
+        vf_field_trainer_free(t);
+    }
+    vf_field_free(truth);
+}
+
 /* The empty-space radius of every cell is its Chebyshev distance to the nearest occupied
  * cell (brute force over a 40 x 30 x 20 grid with two occupied cells), capped. */
 static void test_empty_radius(void)
@@ -659,5 +708,6 @@ int main(int argc, char **argv)
     CHECK_CASE(test_adam_small_team);
     CHECK_CASE(test_checkpoint_resume);
     CHECK_CASE(test_color_models);
+    CHECK_CASE(test_automatic_options);
     return check_finish();
 }
