@@ -239,8 +239,9 @@ const vf_field *vf_field_trainer_field(const vf_field_trainer *t);
 vf_field *vf_field_trainer_take_field(vf_field_trainer *t);
 
 /* Save everything needed to continue (field, optimizer state, schedule position) to path,
- * atomically. */
-vf_status vf_field_trainer_save_checkpoint(const vf_field_trainer *t, const char *path);
+ * atomically. The time it takes (seconds for a big grid: the optimizer state is twice the
+ * field) is not charged to the training budget. */
+vf_status vf_field_trainer_save_checkpoint(vf_field_trainer *t, const char *path);
 
 /* Continue from a checkpoint instead of vf_field_trainer_start(), after adding the same
  * views. VF_EINPUT when it is corrupt, from another version, or was made with other views. */

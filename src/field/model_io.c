@@ -388,10 +388,11 @@ typedef struct checkpoint_state {
     vf_rng rng;
 } checkpoint_state;
 
-vf_status vf_field_trainer_save_checkpoint(const vf_field_trainer *t, const char *path)
+vf_status vf_field_trainer_save_checkpoint(vf_field_trainer *t, const char *path)
 {
     if (!t->field)
         return vf_fail(VF_EINTERNAL, "nothing to checkpoint");
+    const double began = vf_now();
     checkpoint_state st;
     memset(&st, 0, sizeof st);
     st.fingerprint = vf__trainer_views_fingerprint(t);
@@ -421,7 +422,10 @@ vf_status vf_field_trainer_save_checkpoint(const vf_field_trainer *t, const char
         put(&s, t->adam.m[i], bytes);
         put(&s, t->adam.v[i], bytes);
     }
-    return finish_write(&s, tmp);
+    status = finish_write(&s, tmp);
+    /* the budget is for training: a run that checkpoints gets the steps of one that does not */
+    t->start_time += vf_now() - began;
+    return status;
 }
 
 vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
