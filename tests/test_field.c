@@ -482,19 +482,33 @@ static void test_adam_small_team(void)
     vf_field_free(f);
 }
 
-/* Training views: renders of the synthetic field from a ring of cameras. */
-static void add_views(vf_field_trainer *t, const vf_field *f, int count)
+/* Training views: renders of the synthetic field from a ring of cameras, opaque RGB or (with
+ * `alpha`) RGBA with every pixel opaque. */
+static void add_views_as(vf_field_trainer *t, const vf_field *f, int count, int alpha)
 {
     for (int i = 0; i < count; i++) {
         vf_viewpoint v = {.psi = -180 + 360.0 * i / count, .theta = 0, .phi = 40 + 15 * (i % 5)};
         double c2w[16];
         vf_viewpoint_to_c2w(&v, c2w);
-        vf_image img = {0};
+        vf_image img = {0}, rgba = {0};
         vf_field_render(f, &f->camera, c2w, &img);
-        CHECK(vf_field_trainer_add_view(t, &f->camera, c2w, &img) == VF_OK, "add view: %s",
-              vf_error_message());
+        if (alpha) {
+            vf_image_alloc(&rgba, img.width, img.height, 4);
+            for (size_t p = 0; p < (size_t)img.width * img.height; p++) {
+                memcpy(rgba.data + 4 * p, img.data + 3 * p, 3 * sizeof(float));
+                rgba.data[4 * p + 3] = 1.0f;
+            }
+        }
+        CHECK(vf_field_trainer_add_view(t, &f->camera, c2w, alpha ? &rgba : &img) == VF_OK,
+              "add view: %s", vf_error_message());
         vf_image_free(&img);
+        vf_image_free(&rgba);
     }
+}
+
+static void add_views(vf_field_trainer *t, const vf_field *f, int count)
+{
+    add_views_as(t, f, count, 0);
 }
 
 /* The defaults, on a small budget: `steps` steps of 256 rays over a 16^3 grid, 2 threads. */
@@ -624,25 +638,7 @@ static void test_automatic_options(void)
         }
         vf_field_trainer *t = NULL;
         CHECK(vf_field_trainer_create(&opt, &t) == VF_OK, "create: %s", vf_error_message());
-        if (kind == 1) {
-            for (int i = 0; i < 8; i++) {
-                vf_viewpoint v = {.psi = -180 + 45.0 * i, .theta = 0, .phi = 50};
-                double c2w[16];
-                vf_viewpoint_to_c2w(&v, c2w);
-                vf_image rgb = {0}, rgba = {0};
-                vf_field_render(truth, &truth->camera, c2w, &rgb);
-                vf_image_alloc(&rgba, rgb.width, rgb.height, 4);
-                for (size_t p = 0; p < (size_t)rgb.width * rgb.height; p++) {
-                    memcpy(rgba.data + 4 * p, rgb.data + 3 * p, 3 * sizeof(float));
-                    rgba.data[4 * p + 3] = 1.0f;
-                }
-                CHECK(vf_field_trainer_add_view(t, &truth->camera, c2w, &rgba) == VF_OK, "view");
-                vf_image_free(&rgb);
-                vf_image_free(&rgba);
-            }
-        } else {
-            add_views(t, truth, 8);
-        }
+        add_views_as(t, truth, 8, kind == 1);
         CHECK(vf_field_trainer_start(t) == VF_OK, "start: %s", vf_error_message());
         const vf_field_train_options *used = vf_field_trainer_options(t);
         const int outer = vf_field_trainer_field(t)->grid_count == 2;
