@@ -138,8 +138,10 @@ typedef struct vf_field_train_options {
     int steps;               /* number of optimizer steps when seconds is 0 */
     int batch_rays;          /* rays per step */
     double max_points;       /* grid points of the finest object grid (about res^3; the
-                                outer grid gets half as many). 0: automatic: 6M for opaque
-                                photos with an outer grid, else 128^3 (see levels) */
+                                outer grid gets half as many). 0: automatic: for opaque
+                                photos with an outer grid 6M with 3 minutes (or 4500 steps)
+                                or more, proportionally fewer for less, 2M at least; else
+                                128^3 (see levels) */
     int levels;              /* coarse-to-fine levels (each 2x the points of the one before).
                                 0: automatic: 6 for opaque photos with an outer grid, else 3.
                                 Few views of a detailed room overfit a fine grid unless it is
