@@ -313,8 +313,8 @@ typedef struct agreement {
 /* Natural accuracy as the attack sees it: MobileNetV2's top-1 on each photo and on the
  * field's render at that photo's pose, after the same preprocessing (shorter side to 256,
  * centre crop 224); renders are made at that scale directly. Beside it, what the metric
- * allows: the same agreement for the photo against itself moved by one pixel (a pose error
- * of a tenth of a degree) and against itself slightly blurred. */
+ * allows: the same agreement for the photo against itself moved by one pixel (on the fox a
+ * pose error of 0.2 degrees) and against itself slightly blurred. */
 static agreement top1_agreement(const vf_field *f, const view_set *views, const float bg[3])
 {
     vf_classifier *cls;
