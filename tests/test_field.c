@@ -652,21 +652,21 @@ static void test_automatic_options(void)
     }
     vf_field_free(truth);
     /* the automatic grid size follows the budget for opaque photos with an outer grid */
-    vf_field_train_options opt;
-    vf_field_train_defaults(&opt);
     const double minutes[4] = {0.5, 1, 2, 10}, want[4] = {2e6, 2e6, 4e6, 6e6};
     for (int i = 0; i < 4; i++) {
+        vf_field_train_options opt;
+        vf_field_train_defaults(&opt);
         opt.seconds = 60 * minutes[i];
-        const double points = vf__field_automatic_points(&opt, 1);
-        CHECK(fabs(points - want[i]) < 1, "%g minutes: %g points, want %g", minutes[i], points,
-              want[i]);
+        vf__field_resolve_automatic(&opt, 1);
+        CHECK(fabs(opt.max_points - want[i]) < 1, "%g minutes: %g points, want %g", minutes[i],
+              opt.max_points, want[i]);
     }
-    opt.seconds = 0;
-    opt.steps = 2250;
-    CHECK(fabs(vf__field_automatic_points(&opt, 1) - 3e6) < 1 &&
-              vf__field_automatic_points(&opt, 0) == 128.0 * 128 * 128,
-          "2250 steps: %g points with an outer grid, %g without",
-          vf__field_automatic_points(&opt, 1), vf__field_automatic_points(&opt, 0));
+    vf_field_train_options with = {.steps = 2250}, without = with;
+    vf__field_resolve_automatic(&with, 1);
+    vf__field_resolve_automatic(&without, 0);
+    CHECK(fabs(with.max_points - 3e6) < 1 && without.max_points == 128.0 * 128 * 128,
+          "2250 steps: %g points with an outer grid, %g without", with.max_points,
+          without.max_points);
 }
 
 /* The empty-space radius of every cell is its Chebyshev distance to the nearest occupied

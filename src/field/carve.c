@@ -223,18 +223,6 @@ static vf_status grid_over(field_grid *g, const double lo[3], const double hi[3]
     return vf__field_grid_alloc(g, dim, lo_f, (float)voxel);
 }
 
-/* The 6M points of an opaque capture need about 4500 steps (3 minutes on 2 cores) to pay; a
- * shorter budget gets proportionally fewer, 2M at least. At 1 minute, 6M -> 2M points: the
- * fox 21.26 -> 23.02 dB held-out (796 -> 1534 steps), the shoes video 25.29 -> 26.90 dB, the
- * render named like the photo 0 -> 6% and 1 -> 18%. */
-double vf__field_automatic_points(const vf_field_train_options *o, int outer)
-{
-    if (!outer)
-        return 128.0 * 128.0 * 128.0;
-    const double budget = o->seconds > 0 ? o->seconds / 180.0 : o->steps / 4500.0;
-    return 6e6 * (budget > 1 ? 1 : budget < 1.0 / 3 ? 1.0 / 3 : budget);
-}
-
 /* Fill in the options left automatic (vf/field.h), once it is known whether an outer grid
  * models the surroundings. They are kept in the options, so a checkpoint keeps them too.
  *
@@ -248,10 +236,15 @@ double vf__field_automatic_points(const vf_field_train_options *o, int outer)
  * 3000 steps tv_color 3e-5 / 1e-4 / 3e-4 / 1e-3: 23.97 / 23.99 / 23.72 / 23.02 dB; total
  * variation on the density hurt (1e-3: 22.08 dB). Photos with alpha (clean renders, cut-outs)
  * keep the sharpest fit: 2.1M points, 3 levels, no smoothing. */
-static void resolve_automatic(vf_field_train_options *o, int outer)
+void vf__field_resolve_automatic(vf_field_train_options *o, int outer)
 {
+    /* The 6M points need about 4500 steps (3 minutes on 2 cores) to pay; a shorter budget
+     * gets proportionally fewer, 2M at least. At 1 minute, 6M -> 2M points: the fox 21.26 ->
+     * 23.02 dB held-out (796 -> 1534 steps), the shoes video 25.29 -> 26.90 dB, the render
+     * named like the photo 0 -> 6% and 1 -> 18%. */
+    const double budget = o->seconds > 0 ? o->seconds / 180.0 : o->steps / 4500.0;
     if (o->max_points == 0)
-        o->max_points = vf__field_automatic_points(o, outer);
+        o->max_points = outer ? 6e6 * fmin(fmax(budget, 1.0 / 3), 1) : 128.0 * 128.0 * 128.0;
     if (o->levels == 0)
         o->levels = outer ? 6 : 3;
     if (o->tv_color < 0)
@@ -273,10 +266,10 @@ vf_status vf__trainer_build_grid(vf_field_trainer *t)
     /* Opaque photos with an outer grid: a box over 60% of the view, whose finer voxels go to
      * the object while the outer grid takes the room. The fox at 3 minutes: 23.05 dB held-out
      * against 20.85 dB with the box over the whole view; a 0.45 box gave 20.43 dB (measured with
-     * 2M grid points, 3 levels and no colour smoothing; see resolve_automatic). */
+     * 2M grid points, 3 levels and no colour smoothing; see vf__field_resolve_automatic). */
     const vf_field_surroundings around = t->opt.surroundings;
     const int outer = !t->has_alpha && around != VF_SURROUNDINGS_NONE;
-    resolve_automatic(&t->opt, outer);
+    vf__field_resolve_automatic(&t->opt, outer);
     double box_scale = t->opt.box_scale > 0 ? t->opt.box_scale
                        : t->has_alpha       ? 1.2
                        : outer              ? 0.6

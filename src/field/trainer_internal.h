@@ -95,9 +95,9 @@ void vf__trainer_views_free(vf_field_trainer *t);
 /* Where the cameras look (the point nearest all optical axes) and their mean distance to it. */
 void vf__trainer_scene_center(const vf_field_trainer *t, double center[3], double *distance);
 
-/* The automatic max_points (vf/field.h): 128^3 without an outer grid; with one, 6M for a
- * budget of 3 minutes or 4500 steps and more, proportionally fewer for less, 2M at least. */
-double vf__field_automatic_points(const vf_field_train_options *o, int outer);
+/* Fill in the options left automatic (grid size, levels, colour smoothing: vf/field.h) for a
+ * capture with (outer = 1) or without an outer grid around the object. */
+void vf__field_resolve_automatic(vf_field_train_options *o, int outer);
 
 /* Build the object grid: place the box, carve it with the views' alpha masks (visual hull),
  * shrink the box to what is left, and fill the grid at the coarsest level. */
