@@ -176,6 +176,7 @@ static void apply_setting(vf_field_train_options *o, const char *text)
     else if (!strcmp(name, "tv_color")) o->tv_color = (float)v;
     else if (!strcmp(name, "tv_view")) o->tv_view = (float)v;
     else if (!strcmp(name, "opaque")) o->opaque = (float)v;
+    else if (!strcmp(name, "distortion")) o->distortion = (float)v;
     else if (!strcmp(name, "step_ratio")) o->step_ratio = (float)v;
     else if (!strcmp(name, "prune_alpha")) o->prune_alpha = (float)v;
     else if (!strcmp(name, "box_scale")) o->box_scale = (float)v;

@@ -89,18 +89,19 @@ static void test_alpha_table(void)
     vf_field_free(f);
 }
 
-/* loss = g . rgb(ray) for a fixed g, plus `opaque` times the transmittance left; its gradient
- * by vf__field_backward and by central differences. */
+/* loss = g . rgb(ray) for a fixed g, plus the weighted transmittance left and distortion
+ * loss; its gradient by vf__field_backward and by central differences. */
 static double ray_loss(const vf_field *f, const field_ray *ray, field_scratch *sc,
-                       const float g[3], float opaque)
+                       const float g[3], field_ray_losses losses)
 {
     field_march_result res;
     vf__field_march(f, ray, 0.3f, 0.0f, sc, &res);
     return (double)g[0] * res.rgb[0] + (double)g[1] * res.rgb[1] + (double)g[2] * res.rgb[2] +
-           (double)opaque * res.trans;
+           (double)losses.opaque * res.trans +
+           losses.distortion * vf__field_distortion_loss(f, sc->samples, res.count);
 }
 
-static void test_gradients(float opaque)
+static void test_gradients(field_ray_losses losses)
 {
     vf_field *f = make_field();
     field_grid *grid = &f->grids[0];
@@ -122,7 +123,7 @@ static void test_gradients(float opaque)
     CHECK(res.count > 10, "the test ray takes %d samples", res.count);
     CHECK(res.trans > 0.01f && res.trans < 0.99f, "the test ray is partly opaque (T = %g)",
           res.trans);
-    vf__field_backward(f, &ray, &sc, &res, g, opaque, &sink);
+    vf__field_backward(f, &ray, &sc, &res, g, losses, &sink);
     CHECK(sink.count[0] > 8, "the ray touched %zu points", sink.count[0]);
 
     int checked = 0, bad = 0;
@@ -133,9 +134,9 @@ static void test_gradients(float opaque)
             float *value = &grid->values[i * FIELD_CH + ch];
             const float saved = *value, h = 1e-2f;
             *value = saved + h;
-            double up = ray_loss(f, &ray, &sc, g, opaque);
+            double up = ray_loss(f, &ray, &sc, g, losses);
             *value = saved - h;
-            double down = ray_loss(f, &ray, &sc, g, opaque);
+            double down = ray_loss(f, &ray, &sc, g, losses);
             *value = saved;
             double numeric = (up - down) / (2 * h), analytic = sink.grad[0][i * FIELD_CH + ch];
             double err = fabs(numeric - analytic) / fmax(1e-3, fabs(numeric) + fabs(analytic));
@@ -146,9 +147,9 @@ static void test_gradients(float opaque)
     }
     CHECK(checked > 20, "checked %d gradients", checked);
     CHECK(bad == 0,
-          "opaque %g: %d of %d gradients differ from finite differences (worst "
-          "relative %g)",
-          opaque, bad, checked, worst);
+          "opaque %g, distortion %g: %d of %d gradients differ from finite differences "
+          "(worst relative %g)",
+          losses.opaque, losses.distortion, bad, checked, worst);
     free(sink.grad[0]);
     free(sink.touched[0]);
     free(sink.list[0]);
@@ -711,8 +712,9 @@ int main(int argc, char **argv)
     CHECK_CASE(test_fast_math);
     CHECK_CASE(test_alpha_table);
     CHECK_CASE(test_empty_radius);
-    test_gradients(0);
-    test_gradients(0.7f);
+    test_gradients((field_ray_losses){0, 0});
+    test_gradients((field_ray_losses){0.7f, 0});
+    test_gradients((field_ray_losses){0, 2.0f});
     CHECK_CASE(test_render_matches_march);
     CHECK_CASE(test_jumps_skip_only_empty);
     CHECK_CASE(test_model_files);

@@ -173,6 +173,7 @@ typedef struct field_sample {
     float trans;      /* transmittance in front of the sample */
     float rgb[3];     /* colour */
     float dtau;       /* d(sigma * step) / d(raw density) */
+    float t;          /* ray distance */
 } field_sample;
 
 /* Scratch of one thread: sample records for the backward pass. */
@@ -206,12 +207,25 @@ typedef struct field_grad_sink {
     size_t count[FIELD_MAX_GRIDS];
 } field_grad_sink;
 
+/* The weights of a ray's losses beside its colour's. */
+typedef struct field_ray_losses {
+    float opaque;     /* times the transmittance left for the background (0 for rays that may
+                         see nothing) */
+    float distortion; /* times mip-NeRF 360's distortion loss of the ray's weights w_i at
+                         distances s_i (ray distance over the camera distance):
+                         sum_ij w_i w_j |s_i - s_j| + 1/3 sum_i w_i^2 ds_i */
+} field_ray_losses;
+
 /* Accumulate dL/dvalues for one marched ray into the sink: L is the colour loss, given by
- * dL/drgb of the composited colour, plus `opaque` times the transmittance left for the
- * background (0 for rays that may see nothing). `res` is the forward result of the same ray. */
+ * dL/drgb of the composited colour, plus the losses weighted by `losses`. `res` is the forward
+ * result of the same ray. */
 void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
-                        const field_march_result *res, const float dl_drgb[3], float opaque,
-                        field_grad_sink *sink);
+                        const field_march_result *res, const float dl_drgb[3],
+                        field_ray_losses losses, field_grad_sink *sink);
+
+/* The distortion loss of a recorded ray (field_ray_losses), summed in double: the reference
+ * the gradient test checks vf__field_backward against. */
+double vf__field_distortion_loss(const vf_field *f, const field_sample *samples, int count);
 
 /* Clip a ray to a box; returns 0 when it misses. */
 int vf__field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], float *t0,

@@ -141,6 +141,7 @@ static int march_segment(const vf_field *f, int gi, const field_ray *ray, float 
             r->rgb[2] = rgb[2];
             /* d(softplus(x))/dx = sigmoid(x) = e^x / (1 + e^x) */
             r->dtau = scale_step * (x > 20.0f ? 1.0f : ex / (1.0f + ex));
+            r->t = t;
         }
         s->count++;
         float w = s->trans * alpha;
@@ -221,26 +222,89 @@ static inline void scatter(const vf_field *f, field_grad_sink *sink, const field
     }
 }
 
+/* The distortion loss's running sums over the samples before the current one: the weight
+ * and the weighted distance. For sample i (weight w, distance s, step ds),
+ * dL/dw_i = 2 sum_j w_j |s - s_j| + 2/3 w ds, and the sum over j splits at i. */
+typedef struct distortion_sums {
+    float w_total, ws_total; /* over every sample */
+    float w_before, ws_before;
+} distortion_sums;
+
+static inline float distortion_dw(distortion_sums *d, float w, float s, float ds)
+{
+    const float before = s * d->w_before - d->ws_before;
+    const float after = (d->ws_total - d->ws_before - w * s) - s * (d->w_total - d->w_before - w);
+    d->w_before += w;
+    d->ws_before += w * s;
+    return 2.0f * (before + after) + (2.0f / 3.0f) * w * ds;
+}
+
+static inline float sample_distance(const vf_field *f, const field_sample *r)
+{
+    return r->t / (float)f->camera_distance;
+}
+
+static inline float sample_step(const vf_field *f, const field_sample *r)
+{
+    return grid_step(f, &f->grids[r->grid]) / (float)f->camera_distance;
+}
+
+double vf__field_distortion_loss(const vf_field *f, const field_sample *samples, int count)
+{
+    double loss = 0;
+    for (int i = 0; i < count; i++) {
+        const double wi = samples[i].trans * samples[i].alpha, si = sample_distance(f, &samples[i]);
+        for (int j = 0; j < count; j++)
+            loss += wi * samples[j].trans * samples[j].alpha *
+                    fabs(si - sample_distance(f, &samples[j]));
+        loss += wi * wi * sample_step(f, &samples[i]) / 3.0;
+    }
+    return loss;
+}
+
 void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
-                        const field_march_result *res, const float dl_drgb[3], float opaque,
-                        field_grad_sink *sink)
+                        const field_march_result *res, const float dl_drgb[3],
+                        field_ray_losses losses, field_grad_sink *sink)
 {
     const float basis[4] = {1.0f, ray->dir[0], ray->dir[1], ray->dir[2]};
     const float *g = dl_drgb;
     /* With C the full colour and P_i the colour composited up to and including sample i,
      * dC/dtau_i = T_{i+1} c_i - (C - P_i) where tau_i = sigma_i * step (alpha = 1 - e^-tau).
      * The loss `opaque` T_end (T_end the transmittance left for the background, whose
-     * derivative is -T_end) enters C - P_i like the background's colour term T_end bg. */
-    const float g_total =
-        g[0] * res->rgb[0] + g[1] * res->rgb[1] + g[2] * res->rgb[2] + opaque * res->trans;
+     * derivative is -T_end) enters C - P_i like the background's colour term T_end bg.
+     * Any loss of the weights w_k = T_k alpha_k has the same form: with g_k = dL/dw_k,
+     * dL/dtau_i = T_{i+1} g_i - sum_{k>i} w_k g_k; the distortion loss adds its g_k to the
+     * colour's, which takes two passes over the samples for sum_k w_k g_k. */
+    const float lambda = losses.distortion;
+    distortion_sums dist = {0};
+    float g_total =
+        g[0] * res->rgb[0] + g[1] * res->rgb[1] + g[2] * res->rgb[2] + losses.opaque * res->trans;
+    if (lambda > 0) {
+        for (int i = 0; i < res->count; i++) {
+            const field_sample *r = &rec->samples[i];
+            dist.w_total += r->trans * r->alpha;
+            dist.ws_total += r->trans * r->alpha * sample_distance(f, r);
+        }
+        distortion_sums pass = dist;
+        for (int i = 0; i < res->count; i++) {
+            const field_sample *r = &rec->samples[i];
+            const float w = r->trans * r->alpha;
+            const float dw = distortion_dw(&pass, w, sample_distance(f, r), sample_step(f, r));
+            g_total += lambda * w * dw;
+        }
+    }
     float g_prefix = 0;
     for (int i = 0; i < res->count; i++) {
         const field_sample *r = &rec->samples[i];
         float w = r->trans * r->alpha;
         float g_c = g[0] * r->rgb[0] + g[1] * r->rgb[1] + g[2] * r->rgb[2];
-        g_prefix += w * g_c;
+        float g_w = lambda > 0
+                        ? g_c + lambda * distortion_dw(&dist, w, sample_distance(f, r),
+                                                       sample_step(f, r))
+                        : g_c;
+        g_prefix += w * g_w;
         float trans_next = r->trans * (1.0f - r->alpha);
-        float dl_dtau = trans_next * g_c - (g_total - g_prefix);
+        float dl_dtau = trans_next * g_w - (g_total - g_prefix);
         float grad[FIELD_CH] = {0};
         grad[FIELD_CH_DENSITY] = dl_dtau * r->dtau;
         for (int k = 0; k < 3; k++) {
