@@ -30,6 +30,7 @@
 #include <string.h>
 
 #include "vf/classifier.h"
+#include "vf/colmap_model.h"
 #include "vf/dataset.h"
 #include "vf/field.h"
 #include "vf/fsutil.h"
@@ -47,15 +48,21 @@ typedef struct view_set {
     vf_camera *cameras;
     double *c2w;
     vf_image *images;
+    int *point_count; /* sparse points each view sees (a poses stage's folder), or NULL */
+    double **points;
 } view_set;
 
 static void view_set_free(view_set *s)
 {
     for (int i = 0; i < s->count; i++)
         vf_image_free(&s->images[i]);
+    for (int i = 0; s->points && i < s->count; i++)
+        free(s->points[i]);
     free(s->cameras);
     free(s->c2w);
     free(s->images);
+    free(s->point_count);
+    free(s->points);
     memset(s, 0, sizeof *s);
 }
 
@@ -67,7 +74,8 @@ static void die(const char *what)
 
 /* Load a transforms file (a path under ../shared, or one of the user's own with a '/' in
  * front or a './'); frames with index % holdout_every == 0 go to `held` (when holdout_every >
- * 0), the rest to `train`. */
+ * 0), the rest to `train`. A transforms file of a poses stage (points3D.txt and sparse/ beside
+ * it) also gives each view its sparse points, for depth supervision. */
 static void load_views(const char *name, int holdout_every, view_set *train, view_set *held)
 {
     char path[4096];
@@ -78,6 +86,23 @@ static void load_views(const char *name, int holdout_every, view_set *train, vie
         die(name);
     if (vf_dataset_load(path, &ds) != VF_OK)
         die(name);
+    char dir[4096], points_file[4096];
+    vf_path_dirname(dir, sizeof dir, path);
+    vf_path_join(points_file, sizeof points_file, dir, "points3D.txt");
+    vf_colmap_view_points vp = {0};
+    if (vf_is_file(points_file)) {
+        const char **names = malloc(sizeof(char *) * (size_t)ds.count);
+        for (int i = 0; i < ds.count; i++)
+            names[i] = ds.frames[i].image_path;
+        if (vf_colmap_view_points_load(dir, names, ds.count, &vp) != VF_OK)
+            die(points_file);
+        free(names);
+        long total = 0;
+        for (int i = 0; i < ds.count; i++)
+            total += vp.count[i];
+        fprintf(stderr, "%s: %ld sparse points seen, %.0f a view\n", points_file, total,
+                (double)total / ds.count);
+    }
     view_set *sets[2] = {train, held};
     for (int k = 0; k < 2; k++) {
         if (!sets[k])
@@ -86,6 +111,10 @@ static void load_views(const char *name, int holdout_every, view_set *train, vie
         sets[k]->cameras = calloc((size_t)ds.count, sizeof(vf_camera));
         sets[k]->c2w = calloc((size_t)ds.count, 16 * sizeof(double));
         sets[k]->images = calloc((size_t)ds.count, sizeof(vf_image));
+        if (vp.views) {
+            sets[k]->point_count = calloc((size_t)ds.count, sizeof(int));
+            sets[k]->points = calloc((size_t)ds.count, sizeof(double *));
+        }
     }
     int failed = 0;
     for (int i = 0; i < ds.count; i++) {
@@ -96,6 +125,11 @@ static void load_views(const char *name, int holdout_every, view_set *train, vie
         s->cameras[s->count] = ds.frames[i].camera;
         memcpy(s->c2w + 16 * s->count, ds.frames[i].c2w, 16 * sizeof(double));
         s->images[s->count].data = NULL;
+        if (vp.views) { /* the view's points move over */
+            s->point_count[s->count] = vp.count[i];
+            s->points[s->count] = vp.xyz[i];
+            vp.xyz[i] = NULL;
+        }
         /* remember the path in the image slot's order; decode below */
         s->count++;
     }
@@ -119,6 +153,7 @@ static void load_views(const char *name, int holdout_every, view_set *train, vie
     }
     free(slot);
     free(owner);
+    vf_colmap_view_points_free(&vp);
     vf_dataset_free(&ds);
     if (failed)
         die("loading images");
@@ -177,6 +212,7 @@ static void apply_setting(vf_field_train_options *o, const char *text)
     else if (!strcmp(name, "tv_view")) o->tv_view = (float)v;
     else if (!strcmp(name, "opaque")) o->opaque = (float)v;
     else if (!strcmp(name, "distortion")) o->distortion = (float)v;
+    else if (!strcmp(name, "depth")) o->depth = (float)v;
     else if (!strcmp(name, "step_ratio")) o->step_ratio = (float)v;
     else if (!strcmp(name, "prune_alpha")) o->prune_alpha = (float)v;
     else if (!strcmp(name, "box_scale")) o->box_scale = (float)v;
@@ -207,10 +243,14 @@ static vf_field *train(const vf_field_train_options *opt, const view_set *views,
     reset_peak_memory();
     if (vf_field_trainer_create(opt, &t) != VF_OK)
         die("trainer");
-    for (int i = 0; i < views->count; i++)
+    for (int i = 0; i < views->count; i++) {
         if (vf_field_trainer_add_view(t, &views->cameras[i], views->c2w + 16 * i,
                                       &views->images[i]) != VF_OK)
             die("adding a view");
+        if (views->points &&
+            vf_field_trainer_add_view_points(t, views->points[i], views->point_count[i]) != VF_OK)
+            die("adding a view's points");
+    }
     if (vf_field_trainer_start(t) != VF_OK)
         die("starting");
     vf_field_train_status st;

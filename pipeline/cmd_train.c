@@ -6,7 +6,8 @@
 
 static const char usage[] =
     "usage: vfcapture train WS [--minutes M | --steps N] [--holdout N] [--surroundings MODE]\n"
-    "                      [--color MODEL] [--view-smoothing W] [--object-only] [--restart]\n"
+    "                      [--color MODEL] [--view-smoothing W] [--depth W] [--object-only]\n"
+    "                      [--restart]\n"
     "\n"
     "Fit a radiance field (an explicit density + spherical-harmonics grid, coarse to fine) to\n"
     "the posed images of WS: the undistorted frames of the poses stage, or an imported posed\n"
@@ -29,6 +30,10 @@ static const char usage[] =
     "                         0 off): stops noisy photos becoming a speckle; default 1e-4\n"
     "                         for a workspace made from a 3D model (Blender's renders are\n"
     "                         noisy), 0 for photos\n"
+    "      --depth W          how strongly the sparse points of 'vfcapture poses' place the\n"
+    "                         surfaces: each training photo's points pull the rays through\n"
+    "                         them to their distance, over the first half of the training\n"
+    "                         (default 10; 0 off; report.json's depth_points counts them)\n"
     "      --object-only      object mode: cut the object out of every photo (the poses\n"
     "                         stage's sparse points near the centre, minus the surface it\n"
     "                         stands on, seed GrabCut) and train on it alone, on white, as\n"
@@ -42,6 +47,7 @@ enum {
     OPT_SURROUNDINGS,
     OPT_COLOR,
     OPT_VIEW_SMOOTHING,
+    OPT_DEPTH,
     OPT_RESTART,
     OPT_OBJECT_ONLY
 };
@@ -62,6 +68,7 @@ static vf_status parse_options(int argc, char **argv, cli_train *opt)
         {"surroundings", required_argument, NULL, OPT_SURROUNDINGS},
         {"color", required_argument, NULL, OPT_COLOR},
         {"view-smoothing", required_argument, NULL, OPT_VIEW_SMOOTHING},
+        {"depth", required_argument, NULL, OPT_DEPTH},
         {"restart", no_argument, NULL, OPT_RESTART},
         {"object-only", no_argument, NULL, OPT_OBJECT_ONLY},
         {0, 0, 0, 0},
@@ -103,6 +110,11 @@ static vf_status parse_options(int argc, char **argv, cli_train *opt)
                 !(opt->train.view_smoothing >= 0 && opt->train.view_smoothing <= 1))
                 return vf_fail(VF_EINPUT, "--view-smoothing must be a number from 0 to 1, not "
                                           "'%s'", optarg);
+        } else if (c == OPT_DEPTH) {
+            if (cli_parse_doubles(optarg, &opt->train.depth, 1) != 1 ||
+                !(opt->train.depth >= 0 && opt->train.depth <= 1000))
+                return vf_fail(VF_EINPUT, "--depth must be a number from 0 to 1000, not '%s'",
+                               optarg);
         } else if (c == OPT_RESTART) {
             opt->train.restart = 1;
         } else if (c == OPT_OBJECT_ONLY) {

@@ -65,6 +65,8 @@ expect 1 "train: unknown colour model" -- "$tool" train "$ws" --color shiny
 one_line_naming "train: unknown colour model" "--color"
 expect 1 "train: bad smoothing" -- "$tool" train "$ws" --view-smoothing -2
 one_line_naming "train: bad smoothing" "--view-smoothing"
+expect 1 "train: bad depth weight" -- "$tool" train "$ws" --depth nan
+one_line_naming "train: bad depth weight" "--depth"
 expect 1 "render: malformed viewpoint" -- "$tool" render "$ws" --viewpoint 1,2,3 -o "$tmp/x.png"
 one_line_naming "render: malformed viewpoint" "--viewpoint"
 expect 1 "eval: missing test set" -- "$tool" eval "$ws" --transforms "$tmp/none.json"

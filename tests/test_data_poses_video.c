@@ -6,7 +6,8 @@
  *      equal stretches.
  *   2. poses (self-calibrating, exhaustive matching) registers all 12 frames; after a
  *      similarity alignment they agree with instant-ngp's poses of the same photos, which
- *      also proves the frames came out upright.
+ *      also proves the frames came out upright. A short training on them is supervised by
+ *      the sparse points each frame sees (and not with --depth 0).
  *   3. A noise video ingested into the same workspace: poses fails with one line saying why,
  *      exit 1, and the workspace (the good poses included) stays byte for byte as it was. */
 #include <stdlib.h>
@@ -142,6 +143,31 @@ static void poses_of_video(const json_t *report)
     vf_dataset_free(&ref);
 }
 
+/* 2b. A short training on those poses: the sparse points each frame sees supervise the
+ * field's depth (report.json counts their sightings), and --depth 0 turns that off. */
+static void train_on_points(void)
+{
+    char args[2 * VF_PATH_MAX], path[VF_PATH_MAX];
+    vf_path_join(path, sizeof path, ws, "train/report.json");
+    const double weights[2] = {-1, 0}; /* the default, then off */
+    for (int k = 0; k < 2; k++) {
+        snprintf(args, sizeof args, "train '%s' --steps 30 --holdout 0 --restart --quiet%s", ws,
+                 k ? " --depth 0" : "");
+        CHECK(run_tool(args) == 0, "train (%s) exit 0 (stderr in %s/err.txt)",
+              k ? "--depth 0" : "default", tmp);
+        json_t *report = load_json(path);
+        const long long points = json_integer_value(json_object_get(report, "depth_points"));
+        printf("train, depth weight %s: %lld sightings of sparse points\n",
+               weights[k] < 0 ? "default" : "0", points);
+        if (k == 0)
+            CHECK(points >= 30 * KEEP, "each frame's sparse points supervise its depth (%lld)",
+                  points);
+        else
+            CHECK(points == 0 && report, "--depth 0: no depth supervision (%lld)", points);
+        json_decref(report);
+    }
+}
+
 /* A listing of every file under ws with its checksum. */
 static void snapshot(const char *name)
 {
@@ -182,8 +208,10 @@ int main(void)
     snprintf(tmp, sizeof tmp, "%s", vf_test_tmpdir());
     vf_path_join(ws, sizeof ws, tmp, "ws");
     json_t *report = ingest_video();
-    if (report)
+    if (report) {
         poses_of_video(report);
+        train_on_points();
+    }
     json_decref(report);
     noise_video();
     return check_finish();

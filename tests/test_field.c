@@ -98,7 +98,8 @@ static double ray_loss(const vf_field *f, const field_ray *ray, field_scratch *s
     vf__field_march(f, ray, 0.3f, 0.0f, sc, &res);
     return (double)g[0] * res.rgb[0] + (double)g[1] * res.rgb[1] + (double)g[2] * res.rgb[2] +
            (double)losses.opaque * res.trans +
-           losses.distortion * vf__field_distortion_loss(f, sc->samples, res.count);
+           losses.distortion * vf__field_distortion_loss(f, sc->samples, res.count) +
+           losses.depth * vf__field_depth_loss(f, sc->samples, res.count, losses.depth_target);
 }
 
 static void test_gradients(field_ray_losses losses)
@@ -147,9 +148,9 @@ static void test_gradients(field_ray_losses losses)
     }
     CHECK(checked > 20, "checked %d gradients", checked);
     CHECK(bad == 0,
-          "opaque %g, distortion %g: %d of %d gradients differ from finite differences "
-          "(worst relative %g)",
-          losses.opaque, losses.distortion, bad, checked, worst);
+          "opaque %g, distortion %g, depth %g: %d of %d gradients differ from finite "
+          "differences (worst relative %g)",
+          losses.opaque, losses.distortion, losses.depth, bad, checked, worst);
     free(sink.grad[0]);
     free(sink.touched[0]);
     free(sink.list[0]);
@@ -526,6 +527,44 @@ static vf_field_train_options small_training(int steps, int levels)
     return opt;
 }
 
+/* Sparse points land on the pixel whose training ray passes them, at their distance; points
+ * behind the camera or outside the photo are dropped. */
+static void test_view_points(void)
+{
+    vf_field *f = make_field();
+    vf_field_train_options opt = small_training(4, 1);
+    opt.depth = 1;
+    vf_field_trainer *t = NULL;
+    CHECK(vf_field_trainer_create(&opt, &t) == VF_OK, "create");
+    add_views(t, f, 3);
+    const double points[] = {0.1, -0.2, 0.3,   0.4, 0.0, -0.1,  -0.3, 0.25, 0.05,
+                             0.0, 0.0, 40.0, /* behind the last camera (it sits above) */
+                             30.0, 0.0, 0.0}; /* far outside its view */
+    CHECK(vf_field_trainer_add_view_points(t, points, 5) == VF_OK, "add points");
+    CHECK(t->depth_count == 3, "3 of 5 points kept (%zu)", t->depth_count);
+    for (size_t i = 0; i < t->depth_count && i < 3; i++) {
+        field_ray ray;
+        float rgb[3];
+        vf__trainer_pixel_ray(t, t->depth_rays[i].pixel, &ray, rgb);
+        double along = 0, off = 0;
+        for (int a = 0; a < 3; a++)
+            along += (points[3 * i + a] - ray.origin[a]) * ray.dir[a];
+        for (int a = 0; a < 3; a++) {
+            const double d = points[3 * i + a] - ray.origin[a] - along * ray.dir[a];
+            off += d * d;
+        }
+        /* within half a pixel's diagonal of the ray (0.1 units at the distance of 4) */
+        const double pixel = along / f->camera.fx;
+        CHECK(sqrt(off) < 0.71 * pixel, "point %zu passes %.4f from its pixel's ray (pixel %.4f)",
+              i, sqrt(off), pixel);
+        CHECK(fabs(t->depth_rays[i].distance - along) < 0.05 * pixel,
+              "point %zu at distance %.4f, along the ray %.4f", i, t->depth_rays[i].distance,
+              along);
+    }
+    vf_field_trainer_free(t);
+    vf_field_free(f);
+}
+
 static void test_checkpoint_resume(void)
 {
     vf_field *truth = make_field();
@@ -712,14 +751,17 @@ int main(int argc, char **argv)
     CHECK_CASE(test_fast_math);
     CHECK_CASE(test_alpha_table);
     CHECK_CASE(test_empty_radius);
-    test_gradients((field_ray_losses){0, 0});
-    test_gradients((field_ray_losses){0.7f, 0});
-    test_gradients((field_ray_losses){0, 2.0f});
+    test_gradients((field_ray_losses){0});
+    test_gradients((field_ray_losses){.opaque = 0.7f});
+    test_gradients((field_ray_losses){.distortion = 2.0f});
+    test_gradients((field_ray_losses){.depth = 3.0f, .depth_target = 0.9f});
+    test_gradients((field_ray_losses){0.7f, 2.0f, 3.0f, 1.1f});
     CHECK_CASE(test_render_matches_march);
     CHECK_CASE(test_jumps_skip_only_empty);
     CHECK_CASE(test_model_files);
     CHECK_CASE(test_hostile_models);
     CHECK_CASE(test_adam_small_team);
+    CHECK_CASE(test_view_points);
     CHECK_CASE(test_checkpoint_resume);
     CHECK_CASE(test_color_models);
     CHECK_CASE(test_automatic_options);

@@ -65,6 +65,22 @@ vf_status vf_colmap_model_load(const char *dir, vf_colmap_model *model);
 vf_status vf_colmap_points_load(const char *dir, vf_colmap_model *model);
 void vf_colmap_model_free(vf_colmap_model *model);
 
+/* The sparse points each of n photos sees, for depth supervision (vf/field.h): read from a
+ * poses stage's folder, its points3D.txt (object frame) and sparse/images.txt (which image each
+ * track entry is). Photo i is the registered image with the base name of names[i]; it gets
+ * the points whose track includes that image and whose mean reprojection error is at most
+ * VF_COLMAP_DEPTH_ERROR pixels (none when COLMAP does not know the photo). */
+#define VF_COLMAP_DEPTH_ERROR 2.0
+typedef struct vf_colmap_view_points {
+    int views;
+    int *count;   /* count[i] points of photo i */
+    double **xyz; /* xyz[i]: 3 doubles a point */
+} vf_colmap_view_points;
+
+vf_status vf_colmap_view_points_load(const char *poses_dir, const char *const *names, int n,
+                                     vf_colmap_view_points *out);
+void vf_colmap_view_points_free(vf_colmap_view_points *p);
+
 /* The camera or image with this id, or NULL. */
 const vf_colmap_camera *vf_colmap_model_camera(const vf_colmap_model *model, int id);
 const vf_colmap_image *vf_colmap_model_image(const vf_colmap_model *model, int id);

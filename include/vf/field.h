@@ -186,6 +186,12 @@ typedef struct vf_field_train_options {
                                 10-27% faster at 0.01, held-out PSNR about the same, but the
                                 wall clock's renders named like its photos less often (0: off,
                                 the default; measurements in train.c) */
+    float depth;             /* opaque photos with sparse points (vf_field_trainer_add_view_points):
+                                weight of a loss sum_i w_i (s_i - s*)^2 on the rays through the
+                                points' pixels (one ray in 8 of a batch), s* the point's
+                                distance, over the first half of the budget: DS-NeRF's idea,
+                                the surfaces placed where structure from motion saw them.
+                                Default 10; 0 off (measurements in train.c) */
     float carve_share;       /* photos with alpha: a point of the box is carved away when at
                                 least this share of the views that see it find it transparent
                                 (0: one view is enough, for exact masks; cut-outs of real
@@ -198,7 +204,8 @@ typedef struct vf_field_train_options {
 } vf_field_train_options;
 
 /* Fill in the defaults (3 minutes, 8192 rays a step, white background, surroundings
- * modelled for opaque photos, grid size, levels and colour smoothing automatic...). */
+ * modelled for opaque photos, grid size, levels and colour smoothing automatic, depth loss
+ * 10...). */
 void vf_field_train_defaults(vf_field_train_options *opt);
 
 typedef struct vf_field_trainer vf_field_trainer;
@@ -228,6 +235,12 @@ vf_status vf_field_trainer_create(const vf_field_train_options *opt, vf_field_tr
  * object (visual hull). */
 vf_status vf_field_trainer_add_view(vf_field_trainer *t, const vf_camera *cam, const double c2w[16],
                                     const vf_image *image);
+
+/* Depth supervision: the world points (3 doubles each) that structure from motion found in
+ * the view added last, e.g. the sparse points whose tracks include its photo. Points that do
+ * not project into the photo are ignored. Used when options.depth > 0 and the photos are
+ * opaque. */
+vf_status vf_field_trainer_add_view_points(vf_field_trainer *t, const double *xyz, int n);
 
 /* Place the scene box, carve, build the coarse grid and start the clock. */
 vf_status vf_field_trainer_start(vf_field_trainer *t);

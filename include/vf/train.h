@@ -14,7 +14,8 @@
  * from that checkpoint unless `restart` is set, and the checkpoint goes only once the stage is
  * committed. Output: WS/train/model.vff (VF_FIELD_FILE), report.json (mode "scene" or
  * "object", views, held_out_views, steps, seconds, surroundings, color, view_smoothing, field,
- * grid, bytes, held_out_psnr/ssim, held_out [per view]), held_out.jpg. */
+ * grid, bytes, depth_points [sightings of sparse points that supervised the depth, 0 when none
+ * did], held_out_psnr/ssim, held_out [per view]), held_out.jpg. */
 #ifndef VF_TRAIN_H
 #define VF_TRAIN_H
 
@@ -44,6 +45,8 @@ typedef struct vf_train_options {
     double view_smoothing; /* the field's tv_view (vf/field.h); < 0: automatic (-1): 1e-4 for a
                               workspace made from a 3D model, whose Blender renders carry
                               Monte-Carlo noise, 0 for photos */
+    double depth;          /* the field's depth-loss weight (vf/field.h) on the sparse points
+                              of a poses stage; < 0: the trainer's default (-1); 0: off */
     int restart;                        /* ignore a checkpoint of an interrupted run */
     /* Object mode (vf/cutout.h): cut the object out of every photo with the help of the
      * poses stage's sparse points and train on it alone, on white, as on background-removed

@@ -214,6 +214,9 @@ typedef struct field_ray_losses {
     float distortion; /* times mip-NeRF 360's distortion loss of the ray's weights w_i at
                          distances s_i (ray distance over the camera distance):
                          sum_ij w_i w_j |s_i - s_j| + 1/3 sum_i w_i^2 ds_i */
+    float depth;      /* times the depth loss sum_i w_i (s_i - depth_target)^2: the ray's pixel
+                         sees a sparse point at distance depth_target (0: no such point) */
+    float depth_target;
 } field_ray_losses;
 
 /* Accumulate dL/dvalues for one marched ray into the sink: L is the colour loss, given by
@@ -226,6 +229,10 @@ void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scr
 /* The distortion loss of a recorded ray (field_ray_losses), summed in double: the reference
  * the gradient test checks vf__field_backward against. */
 double vf__field_distortion_loss(const vf_field *f, const field_sample *samples, int count);
+
+/* The depth loss of a recorded ray (field_ray_losses) for a point at distance `target`. */
+double vf__field_depth_loss(const vf_field *f, const field_sample *samples, int count,
+                            float target);
 
 /* Clip a ray to a box; returns 0 when it misses. */
 int vf__field_ray_box(const field_ray *ray, const float lo[3], const float hi[3], float *t0,

@@ -262,6 +262,17 @@ double vf__field_distortion_loss(const vf_field *f, const field_sample *samples,
     return loss;
 }
 
+double vf__field_depth_loss(const vf_field *f, const field_sample *samples, int count,
+                            float target)
+{
+    double loss = 0;
+    for (int i = 0; i < count; i++) {
+        const double e = sample_distance(f, &samples[i]) - target;
+        loss += samples[i].trans * samples[i].alpha * e * e;
+    }
+    return loss;
+}
+
 void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scratch *rec,
                         const field_march_result *res, const float dl_drgb[3],
                         field_ray_losses losses, field_grad_sink *sink)
@@ -274,11 +285,17 @@ void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scr
      * derivative is -T_end) enters C - P_i like the background's colour term T_end bg.
      * Any loss of the weights w_k = T_k alpha_k has the same form: with g_k = dL/dw_k,
      * dL/dtau_i = T_{i+1} g_i - sum_{k>i} w_k g_k; the distortion loss adds its g_k to the
-     * colour's, which takes two passes over the samples for sum_k w_k g_k. */
-    const float lambda = losses.distortion;
+     * colour's, which takes two passes over the samples for sum_k w_k g_k; the depth loss's
+     * g_k is depth (s_k - target)^2. */
+    const float lambda = losses.distortion, depth = losses.depth, target = losses.depth_target;
     distortion_sums dist = {0};
     float g_total =
         g[0] * res->rgb[0] + g[1] * res->rgb[1] + g[2] * res->rgb[2] + losses.opaque * res->trans;
+    for (int i = 0; depth > 0 && i < res->count; i++) {
+        const field_sample *r = &rec->samples[i];
+        const float e = sample_distance(f, r) - target;
+        g_total += r->trans * r->alpha * depth * e * e;
+    }
     if (lambda > 0) {
         for (int i = 0; i < res->count; i++) {
             const field_sample *r = &rec->samples[i];
@@ -302,6 +319,10 @@ void vf__field_backward(const vf_field *f, const field_ray *ray, const field_scr
                         ? g_c + lambda * distortion_dw(&dist, w, sample_distance(f, r),
                                                        sample_step(f, r))
                         : g_c;
+        if (depth > 0) {
+            const float e = sample_distance(f, r) - target;
+            g_w += depth * e * e;
+        }
         g_prefix += w * g_w;
         float trans_next = r->trans * (1.0f - r->alpha);
         float dl_dtau = trans_next * g_w - (g_total - g_prefix);

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/colmap_model.h"
 #include "vf/cutout.h"
 #include "vf/dataset.h"
 #include "vf/log.h"
@@ -23,7 +24,7 @@
 void vf_train_defaults(vf_train_options *o)
 {
     *o = (vf_train_options){.minutes = 0, .holdout = 10, .surroundings = VF_SURROUNDINGS_AUTO,
-                            .color = VF_COLOR_VIEW, .view_smoothing = -1};
+                            .color = VF_COLOR_VIEW, .view_smoothing = -1, .depth = -1};
 }
 
 double vf_train_minutes(const vf_train_options *o, int from_model)
@@ -37,6 +38,8 @@ vf_status vf_train_options_check(const vf_train_options *o)
         return vf_fail(VF_EINPUT,
                        "training time must be 0 (the default budget) to 600 minutes, not %g",
                        o->minutes);
+    if (!(o->depth < 0 || o->depth <= 1000))
+        return vf_fail(VF_EINPUT, "the depth weight must be 0 to 1000, not %g", o->depth);
     if (o->steps < 0 || o->holdout < 0 || o->holdout == 1)
         return vf_fail(VF_EINPUT, "steps must be >= 0 and holdout 0 or from 2 up");
     return VF_OK;
@@ -47,9 +50,11 @@ static int is_held_out(int frame, int holdout)
     return holdout > 0 && frame % holdout == holdout / 2;
 }
 
-/* Decode and hand the training views to the trainer; returns whether any has alpha. */
-static vf_status add_training_views(vf_field_trainer *t, const vf_dataset *views, int holdout,
-                                    int *with_alpha)
+/* Decode and hand the training views to the trainer, each with the sparse points it sees
+ * (points may be NULL); returns whether any has alpha and how many points went in. */
+static vf_status add_training_views(vf_field_trainer *t, const vf_dataset *views,
+                                    const vf_colmap_view_points *points, int holdout,
+                                    int *with_alpha, long *points_added)
 {
     vf_status status = VF_OK;
     vf_progress progress;
@@ -64,11 +69,37 @@ static vf_status add_training_views(vf_field_trainer *t, const vf_dataset *views
             status =
                 vf_field_trainer_add_view(t, &views->frames[i].camera, views->frames[i].c2w, &img);
         }
+        if (status == VF_OK && points) {
+            status = vf_field_trainer_add_view_points(t, points->xyz[i], points->count[i]);
+            *points_added += points->count[i];
+        }
         vf_image_free(&img);
         vf_progress_update(&progress, (size_t)i + 1, NULL);
     }
     if (status == VF_OK)
         vf_progress_end(&progress);
+    return status;
+}
+
+/* The sparse points each photo of a real capture sees (depth supervision, vf/field.h); none
+ * (a zeroed set) for posed imports and 3D models, which have no poses stage. */
+static vf_status load_view_points(const vf_workspace *ws, const vf_dataset *views,
+                                  vf_colmap_view_points *out)
+{
+    memset(out, 0, sizeof *out);
+    char dir[VF_PATH_MAX], file[VF_PATH_MAX];
+    vf_status status = vf_workspace_path(ws, "poses", "", dir, sizeof dir);
+    if (status == VF_OK)
+        status = vf_path_join(file, sizeof file, dir, "points3D.txt");
+    if (status != VF_OK || !vf_workspace_has_stage(ws, "poses") || !vf_is_file(file))
+        return status;
+    const char **names = malloc(((size_t)views->count + 1) * sizeof *names);
+    if (!names)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    for (int i = 0; i < views->count; i++)
+        names[i] = views->frames[i].image_path;
+    status = vf_colmap_view_points_load(dir, names, views->count, out);
+    free(names);
     return status;
 }
 
@@ -246,6 +277,8 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         topt.tv_view = (float)opt->view_smoothing;
     else
         topt.tv_view = from_model ? MODEL_VIEW_SMOOTHING : 0.0f;
+    if (opt->depth >= 0)
+        topt.depth = (float)opt->depth;
     if (opt->object_only) /* a cut-out errs in a view or two: the hull keeps what most see */
         topt.carve_share = OBJECT_CARVE_SHARE;
     vf_field_trainer *t = NULL;
@@ -270,10 +303,16 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                          opt->object_only ? "on the whole photos" : "in object mode");
     if (status == VF_OK && opt->object_only)
         status = cut_out_object(ws, stage.dir, &views, &cut_report);
+    vf_colmap_view_points points = {0};
+    long point_total = 0;
+    if (status == VF_OK && !opt->object_only)
+        status = load_view_points(ws, &views, &points);
     if (status == VF_OK)
         status = vf_field_trainer_create(&topt, &t);
     if (status == VF_OK)
-        status = add_training_views(t, &views, opt->holdout, &with_alpha);
+        status = add_training_views(t, &views, points.views ? &points : NULL, opt->holdout,
+                                    &with_alpha, &point_total);
+    vf_colmap_view_points_free(&points);
     if (status == VF_OK && vf_is_file(checkpoint)) {
         vf_info("resuming from the checkpoint of an interrupted run (--restart to start over)");
         status = vf_field_trainer_resume(t, checkpoint);
@@ -326,6 +365,11 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         const vf_field_train_options *used = vf_field_trainer_options(t);
         json_object_set_new(report, "color_smoothing", json_real(used->tv_color));
         json_object_set_new(report, "levels", json_integer(used->levels));
+        /* the sparse points whose depth supervised the field (0: none did) */
+        const long supervising = used->depth > 0 && !with_alpha ? point_total : 0;
+        json_object_set_new(report, "depth_points", json_integer(supervising));
+        if (supervising)
+            vf_info("depth supervision: %ld sightings of sparse points", supervising);
         vf_info("field: %s, %s colour", kind,
                 opt->color == VF_COLOR_DIFFUSE ? "diffuse" : "view-dependent");
         if (held)
@@ -348,12 +392,13 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                                        ssim, "steps", st.step)
                            : json_pack("{s:i}", "steps", st.step);
     status = vf_stage_commit(&stage,
-                             json_pack("{s:f, s:i, s:i, s:s, s:s, s:f, s:b}", "minutes",
+                             json_pack("{s:f, s:i, s:i, s:s, s:s, s:f, s:f, s:b}", "minutes",
                                        minutes, "steps", opt->steps, "holdout", opt->holdout,
                                        "surroundings",
                                        vf_field_surroundings_name(opt->surroundings), "color",
                                        vf_field_color_name(opt->color), "view_smoothing",
-                                       (double)topt.tv_view, "object_only", opt->object_only),
+                                       (double)topt.tv_view, "depth", (double)topt.depth,
+                                       "object_only", opt->object_only),
                              json_incref(summary));
     /* The checkpoint goes only once the stage is in place: after a failed commit the next run
      * resumes from it at its end instead of training again. */

@@ -1,4 +1,5 @@
 /* The training photos, kept compactly (8-bit RGB, background composited) as rays. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -112,6 +113,42 @@ vf_status vf_field_trainer_add_view(vf_field_trainer *t, const vf_camera *cam, c
     return VF_OK;
 }
 
+vf_status vf_field_trainer_add_view_points(vf_field_trainer *t, const double *xyz, int n)
+{
+    if (t->started)
+        return vf_fail(VF_EINTERNAL, "points must be added before training starts");
+    if (t->view_count == 0 || n < 0)
+        return vf_fail(VF_EINTERNAL, "points need a view to belong to");
+    const train_view *v = &t->views[t->view_count - 1];
+    const double *m = v->c2w;
+    for (int i = 0; i < n; i++) {
+        /* to the camera's OpenCV axes: R^T (X - C), then y and z flipped from OpenGL's */
+        const double d[3] = {xyz[3 * i] - m[3], xyz[3 * i + 1] - m[7], xyz[3 * i + 2] - m[11]};
+        double gl[3];
+        for (int a = 0; a < 3; a++)
+            gl[a] = m[a] * d[0] + m[4 + a] * d[1] + m[8 + a] * d[2];
+        const double cv[3] = {gl[0], -gl[1], -gl[2]};
+        double u, w;
+        if (!vf_camera_project(&v->camera, cv, &u, &w) || !(u >= 0 && u < v->camera.width) ||
+            !(w >= 0 && w < v->camera.height))
+            continue;
+        if (t->depth_count == t->depth_capacity) {
+            size_t capacity = t->depth_capacity ? 2 * t->depth_capacity : 4096;
+            depth_ray *grown = realloc(t->depth_rays, capacity * sizeof *grown);
+            if (!grown)
+                return vf_fail(VF_EINTERNAL, "out of memory");
+            t->depth_rays = grown;
+            t->depth_capacity = capacity;
+        }
+        /* the pixel's ray passes within half a pixel of the point: its distance along the
+         * ray is the point's distance from the camera */
+        t->depth_rays[t->depth_count++] = (depth_ray){
+            (uint32_t)(v->first_pixel + (size_t)w * v->camera.width + (size_t)u),
+            (float)sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])};
+    }
+    return VF_OK;
+}
+
 int vf__trainer_pixel_view(const vf_field_trainer *t, size_t p)
 {
     int lo = 0, hi = t->view_count - 1;
@@ -178,6 +215,9 @@ void vf__trainer_views_free(vf_field_trainer *t)
     free(t->tables);
     free(t->rgb);
     free(t->pool);
+    free(t->depth_rays);
+    t->depth_rays = NULL;
+    t->depth_count = t->depth_capacity = 0;
     t->views = NULL;
     t->tables = NULL;
     t->rgb = NULL;

@@ -26,6 +26,13 @@ typedef struct ray_table {
     float *xy; /* 2 floats a pixel */
 } ray_table;
 
+/* A training pixel whose ray sees a sparse point of structure from motion, and the point's
+ * distance from the camera (world units). */
+typedef struct depth_ray {
+    uint32_t pixel;
+    float distance;
+} depth_ray;
+
 typedef struct train_view {
     vf_camera camera;
     double c2w[16];
@@ -57,6 +64,8 @@ struct vf_field_trainer {
     int has_alpha; /* any view came with alpha: carve with it, train on rays near the hull */
     uint32_t *pool; /* top-left pixels of the tiles worth training on */
     size_t pool_size;
+    depth_ray *depth_rays; /* pixels that see a sparse point (vf_field_trainer_add_view_points) */
+    size_t depth_count, depth_capacity;
 
     /* the model and its optimizer */
     vf_field *field;

@@ -335,3 +335,77 @@ void vf_colmap_image_center(const vf_colmap_image *image, double center[3])
     vf_colmap_image_c2w(image, c2w);
     vf_mat4_translation(c2w, center);
 }
+
+void vf_colmap_view_points_free(vf_colmap_view_points *p)
+{
+    for (int i = 0; p->xyz && i < p->views; i++)
+        free(p->xyz[i]);
+    free(p->xyz);
+    free(p->count);
+    memset(p, 0, sizeof *p);
+}
+
+static const char *base_name(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    return slash ? slash + 1 : path;
+}
+
+vf_status vf_colmap_view_points_load(const char *poses_dir, const char *const *names, int n,
+                                     vf_colmap_view_points *out)
+{
+    memset(out, 0, sizeof *out);
+    char sparse[VF_PATH_MAX];
+    vf_colmap_model images = {0}, points = {0};
+    vf_status status = vf_path_join(sparse, sizeof sparse, poses_dir, "sparse");
+    if (status == VF_OK)
+        status = vf_colmap_model_load(sparse, &images);
+    if (status == VF_OK)
+        status = vf_colmap_points_load(poses_dir, &points);
+    int *view_of = NULL; /* per COLMAP image (by index): the photo, or -1 */
+    if (status == VF_OK) {
+        out->views = n;
+        out->count = calloc((size_t)n + 1, sizeof *out->count);
+        out->xyz = calloc((size_t)n + 1, sizeof *out->xyz);
+        view_of = malloc(((size_t)images.image_count + 1) * sizeof *view_of);
+        if (!out->count || !out->xyz || !view_of)
+            status = vf_fail(VF_EINTERNAL, "out of memory");
+    }
+    for (int k = 0; status == VF_OK && k < images.image_count; k++) {
+        view_of[k] = -1;
+        for (int i = 0; i < n && view_of[k] < 0; i++)
+            if (!strcmp(base_name(images.images[k].name), base_name(names[i])))
+                view_of[k] = i;
+    }
+    /* two passes over the tracks: count, then fill */
+    for (int pass = 0; status == VF_OK && pass < 2; pass++) {
+        for (int i = 0; pass == 1 && i < n; i++) {
+            out->xyz[i] = malloc(((size_t)out->count[i] + 1) * 3 * sizeof(double));
+            if (!out->xyz[i])
+                status = vf_fail(VF_EINTERNAL, "out of memory");
+            out->count[i] = 0;
+        }
+        for (int p = 0; status == VF_OK && p < points.point_count; p++) {
+            const vf_colmap_point *pt = &points.points[p];
+            if (!(pt->error <= VF_COLMAP_DEPTH_ERROR))
+                continue;
+            for (int e = 0; e < pt->track_length; e++) {
+                int k = 0;
+                while (k < images.image_count && images.images[k].id != pt->track[2 * e])
+                    k++;
+                const int view = k < images.image_count ? view_of[k] : -1;
+                if (view < 0)
+                    continue;
+                if (pass == 1)
+                    memcpy(out->xyz[view] + 3 * out->count[view], pt->xyz, 3 * sizeof(double));
+                out->count[view]++;
+            }
+        }
+    }
+    free(view_of);
+    vf_colmap_model_free(&images);
+    vf_colmap_model_free(&points);
+    if (status != VF_OK)
+        vf_colmap_view_points_free(out);
+    return status;
+}
