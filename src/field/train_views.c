@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "trainer_internal.h"
+#include "vf/pose.h"
 
 /* The (shared) ray table of a camera: normalized undistorted coordinates of each pixel. */
 static vf_status find_table(vf_field_trainer *t, const vf_camera *cam, int *index)
@@ -120,15 +121,13 @@ vf_status vf_field_trainer_add_view_points(vf_field_trainer *t, const double *xy
     if (t->view_count == 0 || n < 0)
         return vf_fail(VF_EINTERNAL, "points need a view to belong to");
     const train_view *v = &t->views[t->view_count - 1];
-    const double *m = v->c2w;
+    double rot[9], shift[3];
+    vf_c2w_gl_to_w2c_cv(v->c2w, rot, shift);
     for (int i = 0; i < n; i++) {
-        /* to the camera's OpenCV axes: R^T (X - C), then y and z flipped from OpenGL's */
-        const double d[3] = {xyz[3 * i] - m[3], xyz[3 * i + 1] - m[7], xyz[3 * i + 2] - m[11]};
-        double gl[3];
+        double cv[3], u, w;
+        vf_mat3_apply(rot, xyz + 3 * i, cv);
         for (int a = 0; a < 3; a++)
-            gl[a] = m[a] * d[0] + m[4 + a] * d[1] + m[8 + a] * d[2];
-        const double cv[3] = {gl[0], -gl[1], -gl[2]};
-        double u, w;
+            cv[a] += shift[a];
         if (!vf_camera_project(&v->camera, cv, &u, &w) || !(u >= 0 && u < v->camera.width) ||
             !(w >= 0 && w < v->camera.height))
             continue;
@@ -144,7 +143,7 @@ vf_status vf_field_trainer_add_view_points(vf_field_trainer *t, const double *xy
          * ray is the point's distance from the camera */
         t->depth_rays[t->depth_count++] = (depth_ray){
             (uint32_t)(v->first_pixel + (size_t)w * v->camera.width + (size_t)u),
-            (float)sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])};
+            (float)sqrt(cv[0] * cv[0] + cv[1] * cv[1] + cv[2] * cv[2])};
     }
     return VF_OK;
 }

@@ -345,12 +345,6 @@ void vf_colmap_view_points_free(vf_colmap_view_points *p)
     memset(p, 0, sizeof *p);
 }
 
-static const char *base_name(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    return slash ? slash + 1 : path;
-}
-
 vf_status vf_colmap_view_points_load(const char *poses_dir, const char *const *names, int n,
                                      vf_colmap_view_points *out)
 {
@@ -372,10 +366,14 @@ vf_status vf_colmap_view_points_load(const char *poses_dir, const char *const *n
             status = vf_fail(VF_EINTERNAL, "out of memory");
     }
     for (int k = 0; status == VF_OK && k < images.image_count; k++) {
+        char image[VF_PATH_MAX], photo[VF_PATH_MAX];
+        vf_path_basename(image, sizeof image, images.images[k].name, 0);
         view_of[k] = -1;
-        for (int i = 0; i < n && view_of[k] < 0; i++)
-            if (!strcmp(base_name(images.images[k].name), base_name(names[i])))
+        for (int i = 0; i < n && view_of[k] < 0; i++) {
+            vf_path_basename(photo, sizeof photo, names[i], 0);
+            if (!strcmp(image, photo))
                 view_of[k] = i;
+        }
     }
     /* two passes over the tracks: count, then fill */
     for (int pass = 0; status == VF_OK && pass < 2; pass++) {
