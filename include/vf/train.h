@@ -14,8 +14,9 @@
  * from that checkpoint unless `restart` is set, and the checkpoint goes only once the stage is
  * committed. Output: WS/train/model.vff (VF_FIELD_FILE), report.json (mode "scene" or
  * "object", views, held_out_views, steps, seconds, surroundings, color, view_smoothing, field,
- * grid, bytes, depth_points [sightings of sparse points that supervised the depth, 0 when none
- * did], held_out_psnr/ssim, held_out [per view]), held_out.jpg. */
+ * grid, bytes, depth_points [sightings of sparse points in the training photos handed to the
+ * depth loss, which drops any that fall outside their photo; 0 when it was off or had none],
+ * held_out_psnr/ssim, held_out [per view]), held_out.jpg. */
 #ifndef VF_TRAIN_H
 #define VF_TRAIN_H
 

@@ -365,7 +365,7 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         const vf_field_train_options *used = vf_field_trainer_options(t);
         json_object_set_new(report, "color_smoothing", json_real(used->tv_color));
         json_object_set_new(report, "levels", json_integer(used->levels));
-        /* the sparse points whose depth supervised the field (0: none did) */
+        /* the training photos' sightings of sparse points given to the depth loss (0: off) */
         const long supervising = used->depth > 0 && !with_alpha ? point_total : 0;
         json_object_set_new(report, "depth_points", json_integer(supervising));
         if (supervising)
