@@ -21,6 +21,8 @@ python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["surroundi
   && ok || bad "auto: no outer grid for the chair's transparent background, and the report says so"
 python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["color"] == "view" and r["view_smoothing"] == 0, r' "$ws/train/report.json" \
   && ok || bad "the report names the colour model (view-dependent, not smoothed for photos)"
+python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["distortion"] == 0 and r["depth_points"] == 0, r' "$ws/train/report.json" \
+  && ok || bad "background-removed photos: no distortion loss, no depth points"
 python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); assert m["stages"]["train"]["params"]["minutes"] == 3, m["stages"]["train"]' "$ws/manifest.json" \
   && ok || bad "photos get the 3-minute default budget (recorded with the stage)"
 

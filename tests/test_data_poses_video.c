@@ -144,7 +144,8 @@ static void poses_of_video(const json_t *report)
 }
 
 /* 2b. A short training on those poses: the sparse points each frame sees supervise the
- * field's depth (report.json counts their sightings), and --depth 0 turns that off. */
+ * field's depth (report.json counts their sightings), and --depth 0 turns that off; the
+ * opaque frames get the distortion loss. */
 static void train_on_points(void)
 {
     char args[2 * VF_PATH_MAX], path[VF_PATH_MAX];
@@ -159,10 +160,13 @@ static void train_on_points(void)
         const long long points = json_integer_value(json_object_get(report, "depth_points"));
         printf("train, depth weight %s: %lld sightings of sparse points\n",
                weights[k] < 0 ? "default" : "0", points);
-        if (k == 0)
+        if (k == 0) {
             CHECK(points >= 30 * KEEP, "each frame's sparse points supervise its depth (%lld)",
                   points);
-        else
+            const double distortion = json_real_value(json_object_get(report, "distortion"));
+            CHECK(fabs(distortion - 0.01) < 1e-6, /* stored as a float */
+                  "opaque frames get the distortion loss (weight %g)", distortion);
+        } else
             CHECK(points == 0 && report, "--depth 0: no depth supervision (%lld)", points);
         json_decref(report);
     }

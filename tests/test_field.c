@@ -561,7 +561,53 @@ static void test_view_points(void)
               "point %zu at distance %.4f, along the ray %.4f", i, t->depth_rays[i].distance,
               along);
     }
+    /* how far they reach from the origin, per axis: 0.4 (the second point) at the top, 0.3 at
+     * the bottom, each within the half pixel (0.05 units) its pixel's ray may miss it by */
+    const double origin[3] = {0, 0, 0};
+    const double farthest = vf__trainer_points_reach(t, origin, 1.0);
+    const double nearest = vf__trainer_points_reach(t, origin, 0.0);
+    CHECK(fabs(farthest - 0.4) < 0.06 && fabs(nearest - 0.3) < 0.06,
+          "the points reach %.4f (0.4) and %.4f (0.3) from the origin", farthest, nearest);
     vf_field_trainer_free(t);
+    vf_field_free(f);
+}
+
+/* The outer grid of an opaque capture holds the room its sparse points show: a point 16 units
+ * down the last camera's axis (12 past the centre) takes the outer grid out to 1.1 times its
+ * reach, while without points it keeps its default half-size (4 x the view's half-width at
+ * the centre: 4 x 4 x 15 / 40 = 6). */
+static void test_outer_grid_reach(void)
+{
+    vf_field *f = make_field();
+    for (int with_point = 0; with_point < 2; with_point++) {
+        vf_field_train_options opt = small_training(4, 1);
+        vf_field_trainer *t = NULL;
+        CHECK(vf_field_trainer_create(&opt, &t) == VF_OK, "create");
+        add_views(t, f, 3);
+        double reach = 0;
+        if (with_point) {
+            const double *m = t->views[t->view_count - 1].c2w;
+            const double p[3] = {m[3] - 16 * m[2], m[7] - 16 * m[6], m[11] - 16 * m[10]};
+            CHECK(vf_field_trainer_add_view_points(t, p, 1) == VF_OK && t->depth_count == 1,
+                  "the far point is in view");
+            for (int a = 0; a < 3; a++)
+                reach = fmax(reach, fabs(p[a]));
+        }
+        CHECK(vf_field_trainer_start(t) == VF_OK, "start: %s", vf_error_message());
+        const vf_field *trained = vf_field_trainer_field(t);
+        CHECK(trained->grid_count == 2, "opaque views get an outer grid");
+        const field_grid *outer = &trained->grids[1];
+        const double half = 0.5 * (outer->dim[0] - 1) * outer->voxel;
+        const double want = with_point ? 1.1 * reach : 6.0;
+        printf("outer grid %s points: half-size %.3f (want %.3f, voxel %.3f)\n",
+               with_point ? "with" : "without", half, want, outer->voxel);
+        /* the point is rebuilt from its pixel's ray: within half a pixel, 0.2 units at 16 */
+        const double slack = with_point ? 1.1 * 0.2 : 0.01;
+        CHECK(half >= want - slack && half < want + outer->voxel + slack,
+              "outer grid half-size %.3f, want %.3f (%s the far point)", half, want,
+              with_point ? "with" : "without");
+        vf_field_trainer_free(t);
+    }
     vf_field_free(f);
 }
 
@@ -762,6 +808,7 @@ int main(int argc, char **argv)
     CHECK_CASE(test_hostile_models);
     CHECK_CASE(test_adam_small_team);
     CHECK_CASE(test_view_points);
+    CHECK_CASE(test_outer_grid_reach);
     CHECK_CASE(test_checkpoint_resume);
     CHECK_CASE(test_color_models);
     CHECK_CASE(test_automatic_options);

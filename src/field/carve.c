@@ -6,6 +6,8 @@
 #include "trainer_internal.h"
 #include "vf/log.h"
 
+#define POINTS_REACH_MARGIN 1.1 /* the outer grid's half-size over the sparse points' reach */
+
 void vf__trainer_scene_center(const vf_field_trainer *t, double center[3], double *distance)
 {
     /* The point nearest to every optical axis: sum_i (I - d_i d_i^T) (p - o_i) = 0. */
@@ -263,16 +265,21 @@ vf_status vf__trainer_build_grid(vf_field_trainer *t)
     vf__trainer_scene_center(t, center, &distance);
     const vf_camera *cam = &t->views[0].camera;
     double tan_half = fmin(0.5 * cam->width / cam->fx, 0.5 * cam->height / cam->fy);
-    /* Opaque photos with an outer grid: a box over 60% of the view, whose finer voxels go to
+    /* Opaque photos with an outer grid: a box over 80% of the view, whose finer voxels go to
      * the object while the outer grid takes the room. The fox at 3 minutes: 23.05 dB held-out
-     * against 20.85 dB with the box over the whole view; a 0.45 box gave 20.43 dB (measured with
-     * 2M grid points, 3 levels and no colour smoothing; see vf__field_resolve_automatic). */
+     * with a 0.6 box against 20.85 dB with the box over the whole view; a 0.45 box gave 20.43
+     * dB (measured with 2M grid points, 3 levels and no colour smoothing, no sparse points).
+     * With the depth and distortion losses, 4500 steps, 0.6 -> 0.8: the fox 26.31 -> 26.46
+     * dB, renders named like the photos 2 -> 16%; the shoes 30.48 -> 30.26 dB, 56 -> 62%; the
+     * wall clock (seeds 1, 2) 22.16 / 22.18 -> 22.67 / 22.75 dB, 49 / 41 -> 49 / 54% (at 0.6
+     * the box cut off its crest and its base, left to the coarse outer grid); the apple
+     * 17.27 -> 17.52 dB, 5 -> 37%. */
     const vf_field_surroundings around = t->opt.surroundings;
     const int outer = !t->has_alpha && around != VF_SURROUNDINGS_NONE;
     vf__field_resolve_automatic(&t->opt, outer);
     double box_scale = t->opt.box_scale > 0 ? t->opt.box_scale
                        : t->has_alpha       ? 1.2
-                       : outer              ? 0.6
+                       : outer              ? 0.8
                                             : 1.0;
     double view_half = distance * tan_half, half = box_scale * view_half;
     double lo[3], hi[3];
@@ -329,6 +336,18 @@ vf_status vf__trainer_build_grid(vf_field_trainer *t)
         /* a coarse outer grid for what lies around the object box: without it an opaque
          * capture's room is fitted inside the box, as haze (the fox: 21.4 dB held-out) */
         double outer_half = fmax(t->opt.background_scale * view_half, 1.5 * half), olo[3], ohi[3];
+        /* ...and out to the room structure from motion saw, past 98% of the sparse points'
+         * sightings (at most 4x as far): rays that leave the outer grid see the background
+         * colour, so a room beyond it trains into white holes. The apple of CO3D, its floor
+         * and chairs 10-12 units out against the default 4.5: held-out 17.27 -> 23.11 dB at
+         * an outer half-size of 11.1 (4500 steps). */
+        const double room = fmin(POINTS_REACH_MARGIN * vf__trainer_points_reach(t, center, 0.98),
+                                 4.0 * t->opt.background_scale * view_half);
+        if (room > outer_half) {
+            vf_info("outer grid: half-size %.1f, out to the room the sparse points show (%.1f "
+                    "without them)", room, outer_half);
+            outer_half = room;
+        }
         for (int a = 0; a < 3; a++) {
             olo[a] = center[a] - outer_half;
             ohi[a] = center[a] + outer_half;

@@ -365,6 +365,8 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         const vf_field_train_options *used = vf_field_trainer_options(t);
         json_object_set_new(report, "color_smoothing", json_real(used->tv_color));
         json_object_set_new(report, "levels", json_integer(used->levels));
+        /* the distortion loss acts on opaque photos only */
+        json_object_set_new(report, "distortion", json_real(with_alpha ? 0.0 : used->distortion));
         /* the training photos' sightings of sparse points given to the depth loss (0: off) */
         const long supervising = used->depth > 0 && !with_alpha ? point_total : 0;
         json_object_set_new(report, "depth_points", json_integer(supervising));

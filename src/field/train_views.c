@@ -148,6 +148,35 @@ vf_status vf_field_trainer_add_view_points(vf_field_trainer *t, const double *xy
     return VF_OK;
 }
 
+static int compare_floats(const void *a, const void *b)
+{
+    const float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+
+double vf__trainer_points_reach(const vf_field_trainer *t, const double center[3], double share)
+{
+    if (t->depth_count == 0)
+        return 0;
+    float *reach = malloc(t->depth_count * sizeof *reach);
+    if (!reach)
+        return 0; /* only an enlargement is lost */
+    for (size_t i = 0; i < t->depth_count; i++) {
+        field_ray ray;
+        float rgb[3];
+        vf__trainer_pixel_ray(t, t->depth_rays[i].pixel, &ray, rgb);
+        float far = 0;
+        for (int a = 0; a < 3; a++)
+            far = fmaxf(far, fabsf(ray.origin[a] + ray.dir[a] * t->depth_rays[i].distance -
+                                   (float)center[a]));
+        reach[i] = far;
+    }
+    qsort(reach, t->depth_count, sizeof *reach, compare_floats);
+    const double q = reach[(size_t)(share * (double)(t->depth_count - 1))];
+    free(reach);
+    return q;
+}
+
 int vf__trainer_pixel_view(const vf_field_trainer *t, size_t p)
 {
     int lo = 0, hi = t->view_count - 1;

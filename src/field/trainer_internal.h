@@ -93,6 +93,10 @@ void vf__trainer_pixel_ray(const vf_field_trainer *t, size_t p, field_ray *ray, 
 /* Which view a global pixel index belongs to. */
 int vf__trainer_pixel_view(const vf_field_trainer *t, size_t p);
 
+/* How far the sparse points (vf_field_trainer_add_view_points) reach from `center`: the
+ * `share` quantile of their sightings' largest per-axis distance from it; 0 without points. */
+double vf__trainer_points_reach(const vf_field_trainer *t, const double center[3], double share);
+
 /* A fingerprint of the views (sizes, cameras, poses, pixels) so a checkpoint can tell it is
  * resumed on the same data. */
 uint64_t vf__trainer_views_fingerprint(const vf_field_trainer *t);
