@@ -96,6 +96,40 @@ static void add_tv(const field_grid *g, size_t i, float tv_density, float tv_col
         grad[ch] += 2.0f * (tv_color + ((ch - FIELD_CH_SH) % 4 ? tv_view : 0.0f)) * diff[ch];
 }
 
+/* The touched points lie scattered over a grid of hundreds of megabytes, so the loops below
+ * wait on memory, not arithmetic: each asks for the lines of the point PREFETCH entries ahead
+ * in its list while it works on the current one (measured with the marcher's: train.c). */
+#define PREFETCH 8
+
+static FIELD_ALWAYS_INLINE void prefetch_gather(const field_adam *adam, const field_grid *grid,
+                                                int g, size_t i, int use_tv)
+{
+    for (int s = 0; s < adam->threads; s++) {
+        __builtin_prefetch(adam->sinks[s].touched[g] + i);
+        __builtin_prefetch(adam->sinks[s].grad[g] + i * FIELD_CH);
+    }
+    const float *p = grid->values + i * FIELD_CH;
+    __builtin_prefetch(p);
+    if (use_tv) { /* its 6 neighbours, those inside the grid */
+        const size_t row = (size_t)grid->dim[0], slice = row * (size_t)grid->dim[1];
+        const size_t offset[3] = {1, row, slice};
+        for (int a = 0; a < 3; a++) {
+            if (i >= offset[a])
+                __builtin_prefetch(p - offset[a] * FIELD_CH);
+            if (i + offset[a] < grid->points)
+                __builtin_prefetch(p + offset[a] * FIELD_CH);
+        }
+    }
+}
+
+static FIELD_ALWAYS_INLINE void prefetch_update(const field_adam *adam, const field_grid *grid,
+                                                int g, size_t i)
+{
+    __builtin_prefetch(grid->values + i * FIELD_CH, 1);
+    __builtin_prefetch(adam->m[g] + i * FIELD_CH, 1);
+    __builtin_prefetch(adam->v[g] + i * FIELD_CH, 1);
+}
+
 /* Lowest thread whose sink touched point i of grid g. */
 static int owner(const field_adam *adam, int g, size_t i)
 {
@@ -142,6 +176,8 @@ void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH]
             for (int o = me; o < threads; o += team) {
                 field_grad_sink *mine = &adam->sinks[o];
                 for (size_t k = 0; k < mine->count[g]; k++) {
+                    if (k + PREFETCH < mine->count[g])
+                        prefetch_gather(adam, grid, g, mine->list[g][k + PREFETCH], use_tv);
                     size_t i = mine->list[g][k];
                     if (owner(adam, g, i) != o)
                         continue;
@@ -161,6 +197,8 @@ void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH]
             for (int o = me; o < threads; o += team) {
                 field_grad_sink *mine = &adam->sinks[o];
                 for (size_t k = 0; k < mine->count[g]; k++) {
+                    if (k + PREFETCH < mine->count[g])
+                        prefetch_update(adam, grid, g, mine->list[g][k + PREFETCH]);
                     size_t i = mine->list[g][k];
                     if (owner(adam, g, i) == o)
                         adam_update(grid->values + i * FIELD_CH, adam->m[g] + i * FIELD_CH,

@@ -93,6 +93,7 @@ static int march_segment(const vf_field *f, int gi, const field_ray *ray, float 
             continue;
         }
         k += 1.0f;
+        field_prefetch_sample(g, &lat, k);
 
         float fx = field_clamp01(u[0] - (float)c[0]);
         float fy = field_clamp01(u[1] - (float)c[1]);

@@ -1,6 +1,13 @@
 /* The training loop: random batches of rays from every training pixel, forward and backward
  * through the grids, sparse Adam; coarse-to-fine upsampling and occupancy refreshes on a
- * schedule that follows the fraction of the budget (time or steps) used so far. */
+ * schedule that follows the fraction of the budget (time or steps) used so far.
+ *
+ * A step waits on memory: the grids are hundreds of megabytes and every sample and every
+ * touched point is a cache miss. The marcher prefetches the next sample
+ * (field_prefetch_sample), the optimizer the points it updates next (adam.c). Same steps, same
+ * field, sooner: the fox (our poses) 1500 steps in 42.5 s instead of 56.8 (the forward march
+ * alone 7-8% faster); 3 minutes hold 4609 steps instead of 3570 (26.44 against 26.28 dB
+ * held-out), the shoes 3695 instead of 2657, the clock 3137 / 2650, the apple 4754 / 3547. */
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
