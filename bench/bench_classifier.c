@@ -19,20 +19,9 @@
 #include "vf/fsutil.h"
 #include "vf/log.h"
 #include "vf/resources.h"
+#include "vf/stats.h"
 
 #define MAX_MODELS 64
-
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *values, int n)
-{
-    qsort(values, (size_t)n, sizeof *values, compare_doubles);
-    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
 
 /* Median seconds per image of forward() on a batch of n (at most `runs` runs, ~10 s); 0 when it
  * fails. */
@@ -51,7 +40,7 @@ static double time_forward(vf_classifier *cls, const float *input, int n, int ru
         seconds[done] = (vf_now() - t) / n;
     }
     free(probs);
-    return ok ? median(seconds, done) : 0;
+    return ok ? vf_median(seconds, done) : 0;
 }
 
 /* Median seconds of one vf_classifier_preprocess() call on img. */
@@ -64,7 +53,7 @@ static double time_preprocess(const vf_image *img, int size, float *out)
         vf_classifier_preprocess(img, size, out);
         seconds[r] = vf_now() - start;
     }
-    return median(seconds, 15);
+    return vf_median(seconds, 15);
 }
 
 /* Read a float32 file beside the model (NAME.onnx -> NAME<suffix>); NULL when absent. */

@@ -41,6 +41,7 @@
 #include "vf/pose.h"
 #include "vf/resources.h"
 #include "vf/rng.h"
+#include "vf/stats.h"
 #include "vf/viewfool.h"
 
 typedef struct view_set {
@@ -414,12 +415,6 @@ static void print_run(const char *scene, double minutes, const run_result *r, do
     fflush(stdout);
 }
 
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
 /* Times in ms, sorted, of 224x224 classifier-camera renders at n poses (c2w: n 4x4). */
 static void render_times(const vf_field *f, const double *c2w, int n, double *times)
 {
@@ -431,7 +426,7 @@ static void render_times(const vf_field *f, const double *c2w, int n, double *ti
             die("render");
         times[i] = (vf_now() - t0) * 1000;
     }
-    qsort(times, (size_t)n, sizeof *times, compare_doubles);
+    vf_sort_doubles(times, n);
     vf_image_free(&img);
 }
 

@@ -5,19 +5,14 @@
 #include <stdlib.h>
 
 #include "vf/pose.h"
+#include "vf/stats.h"
 
 #define FULL_CIRCLE_GAP 60.0 /* a largest yaw gap below this means the cameras surround it */
-
-static int compare_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 /* Covered yaw arc [lo, hi] (hi may exceed 180): complement of the largest gap. */
 static void yaw_arc(double *psi, int n, double *lo, double *hi)
 {
-    qsort(psi, (size_t)n, sizeof *psi, compare_double);
+    vf_sort_doubles(psi, n);
     int gap_after = n - 1; /* the wrap-around gap, from the last angle to the first + 360 */
     double gap = psi[0] + 360.0 - psi[n - 1];
     for (int i = 0; i + 1 < n; i++)

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/stats.h"
+
 #define LIVE_RING (int)(sizeof(((vf_live_counter *)0)->recent) / sizeof(double))
 
 void vf_select_defaults(vf_select_params *params)
@@ -29,19 +31,6 @@ const char *vf_frame_verdict_name(vf_frame_verdict verdict)
     default:
         return "unused";
     }
-}
-
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* Median of n values (n >= 1); sorts them in place. */
-static double median(double *values, int n)
-{
-    qsort(values, (size_t)n, sizeof *values, compare_doubles);
-    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 static vf_status check_params(const vf_select_params *p)
@@ -84,7 +73,7 @@ static void reject_blurry(const vf_frame_score *scores, const vf_select_params *
     if (all) {
         for (int i = 0; i < s->count; i++)
             all[i] = scores[i].sharpness;
-        double global = median(all, s->count);
+        double global = vf_median(all, s->count);
         for (int i = 0; i < s->count; i++) {
             s->local_median[i] = global;
             if (scores[i].sharpness < p->blur_ratio * global)
@@ -98,7 +87,7 @@ static void reject_blurry(const vf_frame_score *scores, const vf_select_params *
         int hi = i + p->blur_window >= s->count ? s->count - 1 : i + p->blur_window;
         for (int j = lo; j <= hi; j++)
             window[j - lo] = scores[j].sharpness;
-        s->local_median[i] = median(window, hi - lo + 1);
+        s->local_median[i] = vf_median(window, hi - lo + 1);
         if (scores[i].sharpness < p->blur_ratio * s->local_median[i])
             s->verdict[i] = VF_FRAME_BLURRY;
     }
@@ -199,7 +188,7 @@ int vf_live_counter_add(vf_live_counter *c, const vf_frame_score *score,
     double values[LIVE_RING];
     for (int k = 0; k < n; k++)
         values[k] = c->recent[(c->seen - 1 - k) % LIVE_RING];
-    int usable = score->sharpness >= params->blur_ratio * median(values, n) &&
+    int usable = score->sharpness >= params->blur_ratio * vf_median(values, n) &&
                  (c->usable == 0 ||
                   vf_thumb_difference(score, &c->last) >= params->duplicate_threshold);
     if (usable) {

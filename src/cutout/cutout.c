@@ -15,6 +15,7 @@
 #include "vf/plot.h"
 #include "vf/pose.h"
 #include "vf/rng.h"
+#include "vf/stats.h"
 
 #define RANSAC_ROUNDS 500
 #define MIN_PLANE_SHARE 0.15 /* a plane holding fewer of the candidates is no surface */
@@ -87,18 +88,6 @@ static int dominant_plane(const double *p, int n, double tol, uint64_t seed, dou
     return best_count;
 }
 
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median_of(double *x, int n)
-{
-    qsort(x, (size_t)n, sizeof *x, compare_doubles);
-    return n ? x[n / 2] : 0;
-}
-
 static int find_root(int *parent, int i)
 {
     while (parent[i] != i)
@@ -134,7 +123,8 @@ static vf_status central_cluster(double *p, int n, double radius, int *kept)
         }
         nearest[i] = sqrt(best);
     }
-    double link = 3 * median_of(nearest, n), link2 = link * link;
+    vf_sort_doubles(nearest, n);
+    double link = 3 * vf_sorted_quantile(nearest, n, 0.5), link2 = link * link;
     for (int i = 0; i < n; i++)
         parent[i] = i;
     for (int i = 0; i < n; i++)

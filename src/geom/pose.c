@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/stats.h"
+
 static const double PI = 3.14159265358979323846;
 
 static double deg2rad(double deg) { return deg * (PI / 180.0); }
@@ -486,18 +488,6 @@ static double distance3(const double a[3], const double b[3])
                 (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* The q-quantile (nearest rank) of n sorted values. */
-static double sorted_quantile(const double *v, int n, double q)
-{
-    return v[(int)(q * (n - 1) + 0.5)];
-}
-
 vf_status vf_pose_compare(const double *const *ours, const double *const *ref, int n,
                           double distance, vf_pose_agreement *out)
 {
@@ -533,13 +523,13 @@ vf_status vf_pose_compare(const double *const *ours, const double *const *ref, i
         pos[i] = distance > 0 ? distance3(p, dst + 3 * i) / distance : 0;
     }
     if (status == VF_OK) {
-        qsort(rot, (size_t)n, sizeof *rot, compare_doubles);
-        qsort(pos, (size_t)n, sizeof *pos, compare_doubles);
-        out->rot_median = sorted_quantile(rot, n, 0.5);
-        out->rot_p90 = sorted_quantile(rot, n, 0.9);
+        vf_sort_doubles(rot, n);
+        vf_sort_doubles(pos, n);
+        out->rot_median = vf_sorted_quantile(rot, n, 0.5);
+        out->rot_p90 = vf_sorted_quantile(rot, n, 0.9);
         out->rot_max = rot[n - 1];
-        out->pos_median = sorted_quantile(pos, n, 0.5);
-        out->pos_p90 = sorted_quantile(pos, n, 0.9);
+        out->pos_median = vf_sorted_quantile(pos, n, 0.5);
+        out->pos_p90 = vf_sorted_quantile(pos, n, 0.9);
     }
     free(src);
     free(dst);

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/stats.h"
+
 static double dot3(const double a[3], const double b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -84,12 +86,6 @@ static int center_from_axes(const double *c2w, int count, double center[3])
     return 2 * cameras_facing(c2w, count, center) > count;
 }
 
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* Per-axis median of the sparse points that at least half of the cameras face. */
 static int center_from_points(const double *c2w, int count, const double *points, int point_count,
                               double center[3])
@@ -108,8 +104,8 @@ static int center_from_points(const double *c2w, int count, const double *points
         n++;
     }
     for (int k = 0; n > 0 && k < 3; k++) {
-        qsort(axes + k * point_count, (size_t)n, sizeof *axes, compare_doubles);
-        center[k] = axes[k * point_count + n / 2];
+        vf_sort_doubles(axes + k * point_count, n);
+        center[k] = vf_sorted_quantile(axes + k * point_count, n, 0.5);
     }
     free(axes);
     return n > 0;

@@ -15,6 +15,7 @@
 #include "vf/json.h"
 #include "vf/log.h"
 #include "vf/object3d.h"
+#include "vf/stats.h"
 #include "vf/targets.h"
 
 static void phone_defaults(vf_studio_phone *p)
@@ -409,20 +410,6 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
 
 /* ---- the re-shoot's score against its truth ---- */
 
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    if (n == 0)
-        return NAN;
-    qsort(v, (size_t)n, sizeof *v, compare_doubles);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 static int same_file(const char *a, const char *b)
 {
     char ra[PATH_MAX], rb[PATH_MAX];
@@ -509,8 +496,8 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
     /* the edge band: the 90th percentile of that noise (at least a tenth of the tolerance) */
     double band = 0.1 * tolerance;
     if (localized > 0) {
-        qsort(noise, (size_t)localized, sizeof *noise, compare_doubles);
-        band = fmax(band, noise[(int)(0.9 * (localized - 1) + 0.5)]);
+        vf_sort_doubles(noise, localized);
+        band = fmax(band, vf_sorted_quantile(noise, localized, 0.9));
     }
     for (int i = 0; i < seen; i++) { /* score's verdicts on the frames it localized */
         if (!located_flag[i])
@@ -533,8 +520,8 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
             "{s:s, s:s, s:i, s:i, s:f, s:f, s:f, s:i, s:i, s:i, s:i, s:f, s:f, "
             "s:{s:O, s:O, s:O, s:O}, s:O}",
             "video", video, "truth", truth_path, "frames", seen, "localized", localized,
-            "rotation_median_deg", median(rot, localized), "position_median",
-            median(pos, localized), "tolerance", tolerance, "truly_in_box", truly_in, "kept",
+            "rotation_median_deg", vf_median(rot, localized), "position_median",
+            vf_median(pos, localized), "tolerance", tolerance, "truly_in_box", truly_in, "kept",
             kept, "agree", agree, "at_box_edge", edge, "edge_band", band, "agreement",
             localized - edge > 0 ? (double)agree / (localized - edge) : NAN, "physical", "frames",
             json_object_get(k, "frames"), "misclassified", json_object_get(k, "misclassified"),
