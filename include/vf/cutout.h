@@ -9,10 +9,13 @@
  * the object frame: the object at the origin, cameras at a mean distance of 4):
  *   1. points within `radius` of the origin are candidates (the rest is the room);
  *   2. the surface the object stands on (or hangs from) is the dominant plane among them
- *      (RANSAC, seeded): its points, and those behind it as the cameras see it, are dropped;
+ *      (RANSAC, seeded) when it holds 15% of them and more of the rest lie in front of it
+ *      (towards the cameras) than behind (else it is the object's own face, a wall clock's):
+ *      its points, and those behind it, are dropped;
  *   3. the rest is grouped by single linkage (3 times the median distance between
  *      neighbours); the group with the most points within radius / 2 of the origin (the point
- *      the cameras look at lies inside the object) is the object.
+ *      the cameras look at lies in or near the object) is the object, with every other group
+ *      near the origin at least a third its size (an object in parts: a pair of shoes).
  * In each photo those points project to where the object is. They seed OpenCV's GrabCut on a
  * shrunk copy: the points well inside their projected convex hull are sure object, the hull
  * (of the points and their footprints on the surface: an object stands on it, and its
