@@ -611,6 +611,45 @@ static void test_outer_grid_reach(void)
     vf_field_free(f);
 }
 
+/* An opaque capture's boxes go round what its photos centre, not where the optical axes
+ * meet: 40 sparse points on the last camera's axis, 4.5 to 4.9 units out (the axes meet at
+ * 4), move the object box's centre to their median; 20 points off the photo's middle do not
+ * count. */
+static void test_box_on_central_points(void)
+{
+    vf_field *f = make_field();
+    vf_field_train_options opt = small_training(4, 1);
+    vf_field_trainer *t = NULL;
+    CHECK(vf_field_trainer_create(&opt, &t) == VF_OK, "create");
+    add_views(t, f, 3);
+    const double *m = t->views[t->view_count - 1].c2w;
+    const double eye[3] = {m[3], m[7], m[11]}, ahead[3] = {-m[2], -m[6], -m[10]};
+    const double right[3] = {m[0], m[4], m[8]};
+    double points[3 * 60], want[3];
+    for (int i = 0; i < 60; i++) {
+        const double along = i < 40 ? 4.5 + 0.01 * i : 4.0, side = i < 40 ? 0.05 : 1.0;
+        for (int a = 0; a < 3; a++)
+            points[3 * i + a] = eye[a] + along * ahead[a] + side * right[a];
+    }
+    for (int a = 0; a < 3; a++) /* the median of 40: between the 20th and the 21st */
+        want[a] = eye[a] + 4.695 * ahead[a] + 0.05 * right[a];
+    CHECK(vf_field_trainer_add_view_points(t, points, 60) == VF_OK && t->depth_count == 60,
+          "all 60 points in view (%zu)", t->depth_count);
+    CHECK(vf_field_trainer_start(t) == VF_OK, "start: %s", vf_error_message());
+    const field_grid *g = &vf_field_trainer_field(t)->grids[0];
+    double off = 0;
+    for (int a = 0; a < 3; a++) {
+        const double c = 0.5 * (g->lo[a] + g->hi[a]);
+        off = fmax(off, fabs(c - want[a]));
+    }
+    printf("object box centre %.3f from the central points' median (voxel %.3f)\n", off,
+           g->voxel);
+    /* the lattice is centred on the box; points are rebuilt from their pixels' rays */
+    CHECK(off < 0.6 * g->voxel + 0.02, "object box centred %.3f off the central points", off);
+    vf_field_trainer_free(t);
+    vf_field_free(f);
+}
+
 static void test_checkpoint_resume(void)
 {
     vf_field *truth = make_field();
@@ -809,6 +848,7 @@ int main(int argc, char **argv)
     CHECK_CASE(test_adam_small_team);
     CHECK_CASE(test_view_points);
     CHECK_CASE(test_outer_grid_reach);
+    CHECK_CASE(test_box_on_central_points);
     CHECK_CASE(test_checkpoint_resume);
     CHECK_CASE(test_color_models);
     CHECK_CASE(test_automatic_options);

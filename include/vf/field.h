@@ -157,7 +157,9 @@ typedef struct vf_field_train_options {
                                    times tan(half the narrower field of view) (at least 1.5 times
                                    the object box's, and with sparse points out to 1.1 times
                                    where 98% of their sightings lie, up to 4x as far) */
-    float box_scale;            /* object box half-size in the same units (0: automatic: 1.2 for
+    float box_scale;            /* object box half-size in the same units, around the point the
+                                   optical axes meet, or for opaque photos with sparse points
+                                   around those at the photos' middles (0: automatic: 1.2 for
                                    photos with alpha, before the visual hull shrinks it; 0.8 for
                                    opaque photos with an outer grid; 1 without) */
     float step_ratio;           /* sample spacing along a ray, in voxels of the grid marched

@@ -5,6 +5,7 @@
 
 #include "trainer_internal.h"
 #include "vf/pose.h"
+#include "vf/stats.h"
 
 /* The (shared) ray table of a camera: normalized undistorted coordinates of each pixel. */
 static vf_status find_table(vf_field_trainer *t, const vf_camera *cam, int *index)
@@ -175,6 +176,33 @@ double vf__trainer_points_reach(const vf_field_trainer *t, const double center[3
     const double q = reach[(size_t)(share * (double)(t->depth_count - 1))];
     free(reach);
     return q;
+}
+
+int vf__trainer_points_center(const vf_field_trainer *t, double central, double center[3])
+{
+    double *axis = malloc(3 * t->depth_count * sizeof *axis + 1); /* x values, y values, z */
+    if (!axis)
+        return 0;
+    int n = 0;
+    const size_t stride = t->depth_count;
+    for (size_t i = 0; i < t->depth_count; i++) {
+        field_ray ray;
+        float rgb[3];
+        const size_t p = t->depth_rays[i].pixel;
+        vf__trainer_pixel_ray(t, p, &ray, rgb);
+        const double *m = t->views[vf__trainer_pixel_view(t, p)].c2w;
+        const double along = -(ray.dir[0] * m[2] + ray.dir[1] * m[6] + ray.dir[2] * m[10]);
+        if (!(along > 0) || sqrt(fmax(1 - along * along, 0)) > central * along)
+            continue;
+        for (int a = 0; a < 3; a++)
+            axis[a * stride + n] = ray.origin[a] + ray.dir[a] * t->depth_rays[i].distance;
+        n++;
+    }
+    if (n >= 32)
+        for (int a = 0; a < 3; a++)
+            center[a] = vf_median(axis + a * stride, n);
+    free(axis);
+    return n >= 32;
 }
 
 int vf__trainer_pixel_view(const vf_field_trainer *t, size_t p)

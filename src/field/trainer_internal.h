@@ -97,6 +97,11 @@ int vf__trainer_pixel_view(const vf_field_trainer *t, size_t p);
  * `share` quantile of their sightings' largest per-axis distance from it; 0 without points. */
 double vf__trainer_points_reach(const vf_field_trainer *t, const double center[3], double share);
 
+/* What the photographer centred: the per-axis median of the sparse-point sightings that lie
+ * within `central` (a tangent of the angle off the optical axis) of their photo's centre.
+ * Returns 0 (center untouched) with fewer than 32 such sightings. */
+int vf__trainer_points_center(const vf_field_trainer *t, double central, double center[3]);
+
 /* A fingerprint of the views (sizes, cameras, poses, pixels) so a checkpoint can tell it is
  * resumed on the same data. */
 uint64_t vf__trainer_views_fingerprint(const vf_field_trainer *t);
