@@ -46,6 +46,18 @@ static void write_points(const cloud *c, char *dir, size_t size)
         fclose(fp);
 }
 
+/* vf_object_points_find with the default options on the cloud, seen from the cameras. */
+static void find_object(const cloud *c, const double *cameras, int camera_count,
+                        vf_object_points *p)
+{
+    char dir[4096];
+    write_points(c, dir, sizeof dir);
+    vf_cutout_options o;
+    vf_cutout_defaults(&o);
+    CHECK(vf_object_points_find(dir, cameras, camera_count, &o, p) == VF_OK, "find: %s",
+          vf_error_message());
+}
+
 /* How many of the found points lie within tol of the sphere (x, y, z, r). */
 static int on_ball(const vf_object_points *p, double x, double y, double z, double r, double tol)
 {
@@ -74,13 +86,8 @@ static void test_wall_behind_the_origin(void)
     double cameras[3 * 12];
     for (int i = 0; i < 12; i++)
         cameras[3 * i] = 2 * cos(i * 0.5), cameras[3 * i + 1] = -3.5, cameras[3 * i + 2] = sin(i);
-    char dir[4096];
-    write_points(&c, dir, sizeof dir);
-    vf_cutout_options o;
-    vf_cutout_defaults(&o);
     vf_object_points p;
-    CHECK(vf_object_points_find(dir, cameras, 12, &o, &p) == VF_OK, "find: %s",
-          vf_error_message());
+    find_object(&c, cameras, 12, &p);
     const int head = on_ball(&p, 0, -0.8, 0, 0.6, 0.01);
     printf("wall: %d object points (%d on the head of 1500), surface %d (%d points on it)\n",
            p.count, head, p.has_plane, p.on_plane);
@@ -110,13 +117,8 @@ static void test_object_in_parts(void)
     for (int i = 0; i < 12; i++)
         cameras[3 * i] = 3 * cos(i * 0.5), cameras[3 * i + 1] = 3 * sin(i * 0.5),
         cameras[3 * i + 2] = 2.5;
-    char dir[4096];
-    write_points(&c, dir, sizeof dir);
-    vf_cutout_options o;
-    vf_cutout_defaults(&o);
     vf_object_points p;
-    CHECK(vf_object_points_find(dir, cameras, 12, &o, &p) == VF_OK, "find: %s",
-          vf_error_message());
+    find_object(&c, cameras, 12, &p);
     const int left = on_ball(&p, -0.5, 0, -0.05, 0.35, 0.01);
     const int right = on_ball(&p, 0.5, 0.1, -0.05, 0.35, 0.01);
     const int other = on_ball(&p, 1.25, 1.25, -0.25, 0.15, 0.01);
