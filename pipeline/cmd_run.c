@@ -24,7 +24,7 @@ static const char usage[] =
     "  -n, --frames N       frames to keep from a video or photo folder (default 100)\n"
     "      --minutes M      radiance-field training time (default 3; 5 for a 3D model)\n"
     "      --train-steps N  train for N steps instead (the same field on a busy machine)\n"
-    "      --object-only    object mode: train on the object cut out of the photos (see\n"
+    "      --object-only    object mode: the object cut out of the field, on white (see\n"
     "                       'vfcapture train --help')\n"
     "      --samples K      attack samples per step (default 50)\n"
     "      --steps S        attack steps (default 100)\n"

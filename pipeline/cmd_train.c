@@ -34,10 +34,12 @@ static const char usage[] =
     "                         surfaces: each training photo's points pull the rays through\n"
     "                         them to their distance, over the first half of the training\n"
     "                         (default 10; 0 off; report.json's depth_points counts them)\n"
-    "      --object-only      object mode: cut the object out of every photo (the poses\n"
-    "                         stage's sparse points near the centre, minus the surface it\n"
-    "                         stands on, seed GrabCut) and train on it alone, on white, as\n"
-    "                         the paper's objects; WS/train/object/masks.jpg shows the cut\n"
+    "      --object-only      object mode: the object alone, on white, as the paper's\n"
+    "                         objects: each photo's cut (the poses stage's sparse points\n"
+    "                         near the centre, minus the surface it stands on, seed\n"
+    "                         GrabCut; WS/train/object/masks.jpg) votes it out of the\n"
+    "                         field trained on the whole photos, and the surface goes;\n"
+    "                         held_out.jpg shows photos cut by the field's silhouette\n"
     "      --restart          ignore a checkpoint of an interrupted run\n" CLI_COMMON_HELP;
 
 enum {
@@ -152,9 +154,8 @@ int cmd_train(int argc, char **argv)
     if (opt.flags.json)
         cli_print_json(json_pack("{s:s, s:O}", "model", model, "report", report));
     else if (json_object_get(report, "held_out_psnr_object"))
-        printf("trained %.0f steps in %.0f s on the object cut out of the photos; held-out "
-               "views: PSNR %.2f dB inside the masks (%.2f dB with the white around), SSIM "
-               "%.3f\n",
+        printf("trained %.0f steps in %.0f s; held-out views: PSNR %.2f dB inside the "
+               "object's masks (%.2f dB with the white around), SSIM %.3f\n",
                steps, seconds,
                json_number_value(json_object_get(report, "held_out_psnr_object")), psnr, ssim);
     else if (json_object_get(report, "held_out_psnr"))

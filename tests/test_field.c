@@ -650,6 +650,101 @@ static void test_box_on_central_points(void)
     vf_field_free(f);
 }
 
+/* Object mode's cut (vf_field_cut_object) on a known scene: ball A (the object) and ball B
+ * (clutter) on a slab (the surface). Six views' masks are discs round A's projection, one
+ * of them empty (a failed cut-out): the vote keeps all of A and drops B; the slab under A,
+ * inside most masks, goes with the plane only; the silhouette is A's. */
+static void test_object_cut(void)
+{
+    enum { VIEWS = 6, SIDE = 64 };
+    const vf_camera cam = {.width = SIDE, .height = SIDE, .fx = 80, .fy = 80, .cx = 32, .cy = 32};
+    const double a_centre[3] = {-0.4, 0.1, 0.2}; /* make_sparse_field's first ball */
+    vf_field_cut_view views[VIEWS];
+    static uint8_t masks[VIEWS][SIDE * SIDE];
+    for (int i = 0; i < VIEWS; i++) {
+        const vf_viewpoint v = {.psi = 60.0 * i, .theta = 30};
+        views[i].camera = cam;
+        vf_viewpoint_to_c2w(&v, views[i].c2w);
+        views[i].mask = masks[i];
+        double rot[9], t[3], pc[3], u, w;
+        vf_c2w_gl_to_w2c_cv(views[i].c2w, rot, t);
+        vf_mat3_apply(rot, a_centre, pc);
+        for (int k = 0; k < 3; k++)
+            pc[k] += t[k];
+        vf_camera_project(&cam, pc, &u, &w);
+        const double r = 1.3 * cam.fx * 0.25 / pc[2]; /* A's radius in pixels, with a margin */
+        for (int y = 0; y < SIDE; y++)
+            for (int x = 0; x < SIDE; x++)
+                masks[i][y * SIDE + x] =
+                    i != 2 && (x + 0.5 - u) * (x + 0.5 - u) + (y + 0.5 - w) * (y + 0.5 - w) < r * r;
+    }
+    const double plane[4] = {0, 0, 1, 0.1}; /* z = -0.1, the slab's top; A reaches down to -0.05 */
+    for (int with_plane = 0; with_plane < 2; with_plane++) {
+        vf_field *f = make_sparse_field();
+        field_grid *g = &f->grids[0];
+        const float d_min =
+            vf__field_density_threshold(f, FIELD_VISIBLE_ALPHA, f->step_ratio * g->voxel);
+        for (size_t i = 0; i < g->points; i++)
+            if (fabsf(g->lo[2] + g->voxel * (float)(i / (48 * 48)) + 0.175f) < 0.075f)
+                g->values[i * FIELD_CH + FIELD_CH_DENSITY] = 2.0f; /* the slab, just under A */
+        int a_total = 0, a_kept = 0, b_kept = 0, slab_kept = 0;
+        char *was = calloc(g->points, 1);
+        for (size_t i = 0; i < g->points; i++)
+            was[i] = g->values[i * FIELD_CH + FIELD_CH_DENSITY] >= d_min;
+        double kept = -1;
+        CHECK(vf_field_cut_object(f, views, VIEWS, 0.5, with_plane ? plane : NULL, 0.02, &kept) ==
+                  VF_OK,
+              "cut: %s", vf_error_message());
+        for (size_t i = 0; i < g->points; i++) {
+            if (!was[i])
+                continue;
+            const double p[3] = {g->lo[0] + g->voxel * (double)(i % 48),
+                                 g->lo[1] + g->voxel * (double)(i / 48 % 48),
+                                 g->lo[2] + g->voxel * (double)(i / (48 * 48))};
+            const int on = g->values[i * FIELD_CH + FIELD_CH_DENSITY] >= d_min;
+            double da = 0;
+            for (int k = 0; k < 3; k++)
+                da += (p[k] - a_centre[k]) * (p[k] - a_centre[k]);
+            if (p[2] < -0.1)
+                slab_kept += on;
+            else if (da < 0.3 * 0.3)
+                a_total++, a_kept += on;
+            else
+                b_kept += on;
+        }
+        free(was);
+        printf("object cut %s the plane: ball A %d of %d points kept, ball B %d, slab %d; "
+               "kept share %.3f\n", with_plane ? "with" : "without", a_kept, a_total, b_kept,
+               slab_kept, kept);
+        CHECK(a_total > 100 && a_kept == a_total, "the object stays whole (%d of %d)", a_kept,
+              a_total);
+        CHECK(b_kept == 0, "the clutter goes (%d points left)", b_kept);
+        if (with_plane)
+            CHECK(slab_kept == 0, "the surface goes (%d points left)", slab_kept);
+        else /* the masks' discs cover the slab just under A from most views */
+            CHECK(slab_kept > 0, "without the plane the vote alone keeps some slab");
+        CHECK(f->background[0] == 1 && f->background[1] == 1 && f->background[2] == 1,
+              "white background");
+        vf_image opacity = {0};
+        CHECK(vf_field_render_opacity(f, &cam, views[0].c2w, &opacity) == VF_OK &&
+                  opacity.channels == 1,
+              "opacity render");
+        int inside = 0, outside = 0, leaks = 0;
+        for (int p = 0; p < SIDE * SIDE; p++) {
+            if (masks[0][p])
+                inside += opacity.data[p] > 0.5f;
+            else
+                leaks += opacity.data[p] > 0.5f, outside++;
+        }
+        printf("  view 0: %d pixels opaque inside the mask, %d of %d outside\n", inside, leaks,
+               outside);
+        CHECK(inside > 50 && (!with_plane || leaks == 0),
+              "the silhouette is the object's (%d in, %d out)", inside, leaks);
+        vf_image_free(&opacity);
+        vf_field_free(f);
+    }
+}
+
 static void test_checkpoint_resume(void)
 {
     vf_field *truth = make_field();
@@ -849,6 +944,7 @@ int main(int argc, char **argv)
     CHECK_CASE(test_view_points);
     CHECK_CASE(test_outer_grid_reach);
     CHECK_CASE(test_box_on_central_points);
+    CHECK_CASE(test_object_cut);
     CHECK_CASE(test_checkpoint_resume);
     CHECK_CASE(test_color_models);
     CHECK_CASE(test_automatic_options);

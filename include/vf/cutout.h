@@ -2,8 +2,10 @@
  *
  * A phone capture shows the object on a desk, a floor or a wall, with the room around it. The
  * paper photographed its objects on white paper and its classifiers' test images have white
- * backgrounds, so object mode trains the field on the object alone: each photo is cut out
- * (RGBA, the rest transparent) and the field is trained as on background-removed photos.
+ * backgrounds, so object mode renders the object alone on white: each photo is cut out
+ * (RGBA, the rest transparent, this module), and the train stage cuts the object out of the
+ * field trained on the whole photos by those masks' vote and this module's support plane
+ * (vf/field.h vf_field_cut_object).
  *
  * Where the object is comes from the poses stage's sparse points (WS/poses/points3D.txt, in
  * the object frame: the object at the origin, cameras at a mean distance of 4):

@@ -69,6 +69,11 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
 vf_status vf_field_render_viewpoints(const vf_field *f, const vf_camera *cam,
                                      const vf_viewpoint *viewpoints, int n, vf_image *out);
 
+/* The field's opacity (1 - transmittance, 0..1) at each pixel of the view, into `out` (one
+ * channel, (re)allocated as in vf_field_render): its silhouette. */
+vf_status vf_field_render_opacity(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                                  vf_image *out);
+
 /* The pinhole camera whose size x size image equals what a classifier sees of a training
  * photo: the photo resized so its shorter side is size * 256 / 224, then centre-cropped to
  * size x size (vf_classifier_preprocess). Lens distortion is dropped. */
@@ -108,6 +113,27 @@ vf_status vf_field_load_workspace(const struct vf_workspace *ws, vf_field **out)
 
 /* Release a field; NULL is fine. */
 void vf_field_free(vf_field *f);
+
+/* ---- object mode: the object cut out of a field of the whole scene ----------------------- */
+
+/* One photo's say on where the object is: its camera, pose, and mask (camera.width x
+ * camera.height bytes, row-major, nonzero on the object; borrowed). */
+typedef struct vf_field_cut_view {
+    vf_camera camera;
+    double c2w[16];
+    const uint8_t *mask;
+} vf_field_cut_view;
+
+/* Cut the object out of a field trained on whole photos. Every grid point with visible
+ * density is kept only when (a) fewer than `share` of the views that see it find it outside
+ * their mask (a vote: a cut-out that errs in a view or two does not cut the object; a point
+ * no view sees goes) and (b) with a plane (n.x + d = 0, n towards the cameras: the surface the
+ * object stands on or hangs from; NULL for none), it lies at least `clearance` in front of it
+ * (papers, a tablecloth, the wall's paint go with the surface). Everything else becomes empty
+ * space, and the background white, as for background-removed photos. *kept_share (may be
+ * NULL) gets the share of visible grid points kept. Views' masks are read, not kept. */
+vf_status vf_field_cut_object(vf_field *f, const vf_field_cut_view *views, int n, double share,
+                              const double *plane, double clearance, double *kept_share);
 
 /* ---- training ---------------------------------------------------------------------------- */
 

@@ -14,9 +14,9 @@
  * the cut-out), each with "on target" or "natural" and its class, red when fooled.
  *
  * When the field was trained in object mode (vf/train.h object_only), each localized frame is
- * cut out the same way (vf/cutout.h, posed by its localization) and classified on white, so
- * the attack and the physical measurement see the same thing ("mode": "object", and each
- * frame's "object_coverage"). */
+ * cut out by the field's silhouette at the frame's pose (opacity over a half) and classified
+ * on white, so the attack and the physical measurement see the same object ("mode":
+ * "object", and each frame's "object_coverage"). */
 #ifndef VF_SCORE_H
 #define VF_SCORE_H
 

@@ -50,11 +50,14 @@ typedef struct vf_train_options {
                               of a poses stage; < 0: the trainer's default (-1); 0: off */
     int restart;                        /* ignore a checkpoint of an interrupted run */
     /* Object mode (vf/cutout.h): cut the object out of every photo with the help of the
-     * poses stage's sparse points and train on it alone, on white, as on background-removed
-     * photos. WS/train/object/ keeps the cut-out views (RGBA), their transforms.json and
-     * masks.jpg; report.json says "mode": "object" with the cut's figures and the held-out
-     * PSNR inside the masks (held_out_psnr_object). Needs a poses stage (a posed import has
-     * no sparse points). */
+     * poses stage's sparse points; train on the whole photos as in scene mode; then the
+     * training views' cuts vote the object out of the field and the surface it stands on
+     * goes (vf_field_cut_object), the rest rendered on white. WS/train/object/ keeps the
+     * cut-out views (RGBA), their transforms.json and masks.jpg; report.json says "mode":
+     * "object" with the cut's figures ("cutout", its "field_cut") and the held-out PSNR
+     * inside the object's masks (held_out_psnr_object), a held-out photo's mask being the
+     * field's silhouette in it (opacity over a half), as held_out.jpg shows. Needs a poses
+     * stage (a posed import has no sparse points). */
     int object_only;
 } vf_train_options;
 

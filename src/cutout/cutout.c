@@ -585,9 +585,13 @@ vf_status vf_cutout_views(const vf_dataset *views, const char *points_dir, const
                             "surface_found", pts.has_plane, "mean_coverage",
                             views->count ? sum / views->count : 0.0, "empty_views", empty,
                             "views", list);
+        if (pts.has_plane) /* the train stage cuts it out of the field too */
+            json_object_set_new(*report, "surface", json_pack("[f,f,f,f]", pts.plane[0],
+                                                              pts.plane[1], pts.plane[2],
+                                                              pts.plane[3]));
         if (empty)
-            vf_warn("object mode: %d of %d views show no object; they train as empty views",
-                    empty, views->count);
+            vf_warn("object mode: %d of %d views show no object; their masks vote against "
+                    "everything they see", empty, views->count);
     }
     if (status != VF_OK)
         vf_dataset_free(out);

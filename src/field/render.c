@@ -59,10 +59,11 @@ static vf_status check_poses(const double *c2w, int n)
     return VF_OK;
 }
 
-/* Render one image into rgb (3 floats a pixel) with the field's render setup (made once for a
- * batch of images). Runs in the calling thread; `parallel` spreads rows over the cores. */
+/* Render one image into rgb (3 floats a pixel; or, when opacity is given, its opacity there
+ * instead, 1 float a pixel) with the field's render setup (made once for a batch of images).
+ * Runs in the calling thread; `parallel` spreads rows over the cores. */
 static void render_rows(const vf_field *f, const field_render_setup *setup, const vf_camera *cam,
-                        const double c2w[16], float *rgb, int parallel)
+                        const double c2w[16], float *rgb, float *opacity, int parallel)
 {
     enum { RUN = 64 }; /* pixels of a row marched together (vf__field_render_rays) */
     const int width = cam->width, height = cam->height;
@@ -77,31 +78,43 @@ static void render_rows(const vf_field *f, const field_render_setup *setup, cons
             vf__field_render_rays(f, setup, rays, n, 0.5f, f->stop_transmittance, res);
             for (int j = 0; j < n; j++) {
                 const size_t i = (size_t)y * width + x0 + j;
-                memcpy(rgb + 3 * i, res[j].rgb, sizeof res[j].rgb);
+                if (opacity)
+                    opacity[i] = 1.0f - res[j].trans;
+                else
+                    memcpy(rgb + 3 * i, res[j].rgb, sizeof res[j].rgb);
             }
         }
     }
 }
 
-/* One image, its rows spread over the cores. */
-static void render_one(const vf_field *f, const vf_camera *cam, const double c2w[16], float *rgb)
-{
-    field_render_setup setup;
-    vf__field_render_setup_init(f, &setup);
-    render_rows(f, &setup, cam, c2w, rgb, 1);
-}
-
-vf_status vf_field_render(const vf_field *f, const vf_camera *cam, const double c2w[16],
-                          vf_image *out)
+/* One image, its rows spread over the cores: colour (3 channels) or opacity (1). */
+static vf_status render_one(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                            int opacity, vf_image *out)
 {
     vf_status status = check_camera(cam);
     if (status == VF_OK)
         status = check_poses(c2w, 1);
     if (status == VF_OK)
-        status = ensure_image(out, cam->width, cam->height, 3);
-    if (status == VF_OK)
-        render_one(f, cam, c2w, out->data);
+        status = ensure_image(out, cam->width, cam->height, opacity ? 1 : 3);
+    if (status == VF_OK) {
+        field_render_setup setup;
+        vf__field_render_setup_init(f, &setup);
+        render_rows(f, &setup, cam, c2w, opacity ? NULL : out->data, opacity ? out->data : NULL,
+                    1);
+    }
     return status;
+}
+
+vf_status vf_field_render(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                          vf_image *out)
+{
+    return render_one(f, cam, c2w, 0, out);
+}
+
+vf_status vf_field_render_opacity(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                                  vf_image *out)
+{
+    return render_one(f, cam, c2w, 1, out);
 }
 
 vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const double *c2w, int n,
@@ -121,10 +134,10 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
     if ((size_t)cam->width * cam->height <= 512 * 512 && n > 1) {
 #pragma omp parallel for schedule(dynamic, 1)
         for (int i = 0; i < n; i++)
-            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, 0);
+            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, NULL, 0);
     } else {
         for (int i = 0; i < n; i++)
-            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, 1);
+            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, NULL, 1);
     }
     return VF_OK;
 }

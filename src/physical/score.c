@@ -9,8 +9,7 @@
 
 #include "vf/attack_file.h"
 #include "vf/classifier.h"
-#include "vf/cutout.h"
-#include "vf/dataset.h"
+#include "vf/field.h"
 #include "vf/frames.h"
 #include "vf/log.h"
 #include "vf/object3d.h"
@@ -18,6 +17,7 @@
 #include "vf/pose.h"
 #include "vf/resources.h"
 #include "vf/sharpness.h"
+#include "vf/stats.h"
 #include "vf/targets.h"
 #include "vf/wilson.h"
 
@@ -47,9 +47,8 @@ typedef struct score_run {
     int frame_count; /* frames in the input (pass 1) */
     json_t *frames;
     double localize_seconds;
-    int object_mode;         /* the field was trained on the object cut out (vf/cutout.h) */
-    vf_object_points object; /* then each frame is cut out the same way before classifying */
-    vf_cutout_options cutout;
+    int object_mode;  /* the field was trained in object mode (vf/train.h object_only) */
+    vf_field *field;  /* then its silhouette cuts each frame out before classifying */
     int classified;               /* frames classified so far */
     vf_image sheet[SHEET_MAX];    /* what the classifier saw of some of them */
     char *caption[SHEET_MAX];
@@ -99,47 +98,51 @@ static vf_status measure_sharpness(score_run *run)
     if (status == VF_OK && n == 0)
         status = vf_fail(VF_EINPUT, "no frames in the given input");
     if (status == VF_OK) {
-        /* median by partial sort (n is at most a few thousand) */
-        for (int i = 0; i <= n / 2; i++)
-            for (int j = i + 1; j < n; j++)
-                if (values[j] < values[i]) {
-                    double t = values[i];
-                    values[i] = values[j];
-                    values[j] = t;
-                }
-        run->sharpness_threshold = run->opt->blur_ratio * values[n / 2];
+        vf_sort_doubles(values, n); /* the median, the upper of the middle two when n is even */
+        run->sharpness_threshold = run->opt->blur_ratio * vf_sorted_quantile(values, n, 0.5);
         run->frame_count = n;
     }
     free(values);
     return status;
 }
 
-/* Object mode, as the train stage did it: the same points and options. */
+/* Object mode, as the train stage did it: the object is what its field (cut out of the scene,
+ * vf_field_cut_object) shows, so a frame's mask is the field's silhouette at the frame's
+ * localized pose: the attack and the measurement see the same object. */
 static vf_status open_object_mode(score_run *run, const vf_workspace *ws)
 {
     const json_t *params = json_object_get(vf_workspace_stage_record(ws, "train"), "params");
     if (!json_is_true(json_object_get(params, "object_only")))
         return VF_OK;
-    vf_dataset views = {0};
-    char poses[VF_PATH_MAX];
-    vf_status status = vf_dataset_load_training(ws, &views, NULL);
-    double *cameras = status == VF_OK ? malloc((size_t)(views.count + 1) * 3 * sizeof(double))
-                                      : NULL;
-    if (status == VF_OK && !cameras)
-        status = vf_fail(VF_EINTERNAL, "out of memory");
-    for (int i = 0; status == VF_OK && i < views.count; i++)
-        vf_mat4_translation(views.frames[i].c2w, cameras + 3 * i);
-    vf_cutout_defaults(&run->cutout);
-    if (status == VF_OK)
-        status = vf_workspace_path(ws, "poses", "", poses, sizeof poses);
-    if (status == VF_OK)
-        status = vf_object_points_find(poses, cameras, views.count, &run->cutout, &run->object);
+    vf_status status = vf_field_load_workspace(ws, &run->field);
     run->object_mode = status == VF_OK;
     if (run->object_mode)
-        vf_info("object mode (as the field was trained): each frame's object is cut out and "
-                "classified on white");
-    free(cameras);
-    vf_dataset_free(&views);
+        vf_info("object mode (as the field was trained): each frame is cut out by the field's "
+                "silhouette at its pose and classified on white");
+    return status;
+}
+
+/* The field's silhouette (opacity over a half) in a frame seen by cam from c2w: *mask gets
+ * width x height bytes (1 on the object). Rendered at most SILHOUETTE_SIDE pixels long. */
+#define SILHOUETTE_SIDE 480
+static vf_status silhouette_mask(const vf_field *field, const vf_camera *cam,
+                                 const double c2w[16], uint8_t **mask)
+{
+    const int w = cam->width, h = cam->height, longer = w > h ? w : h;
+    const double scale = longer > SILHOUETTE_SIDE ? (double)SILHOUETTE_SIDE / longer : 1.0;
+    const int sw = (int)lround(w * scale) > 0 ? (int)lround(w * scale) : 1;
+    const int sh = (int)lround(h * scale) > 0 ? (int)lround(h * scale) : 1;
+    const vf_camera small = vf_camera_scaled(cam, sw, sh);
+    vf_image opacity = {0};
+    vf_status status = vf_field_render_opacity(field, &small, c2w, &opacity);
+    if (status == VF_OK && !(*mask = malloc((size_t)w * h)))
+        status = vf_fail(VF_EINTERNAL, "out of memory");
+    for (int y = 0; status == VF_OK && y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const int sx = (int)((x + 0.5) * sw / w), sy = (int)((y + 0.5) * sh / h);
+            (*mask)[(size_t)y * w + x] = opacity.data[(size_t)sy * sw + sx] > 0.5f;
+        }
+    vf_image_free(&opacity);
     return status;
 }
 
@@ -168,10 +171,9 @@ static vf_status classify(score_run *run, const vf_rgb8 *frame, const double c2w
     vf_status status = probs ? vf_image_alloc(&img, frame->width, frame->height, 3)
                              : vf_fail(VF_EINTERNAL, "out of memory");
     vf_camera cam;
-    int seen;
     if (status == VF_OK && run->object_mode &&
         (status = vf_localizer_camera(run->loc, frame->width, frame->height, &cam)) == VF_OK)
-        status = vf_cutout_mask(frame, &cam, c2w, &run->object, &run->cutout, &mask, &seen);
+        status = silhouette_mask(run->field, &cam, c2w, &mask);
     if (status == VF_OK) {
         size_t n = (size_t)frame->width * frame->height, on = 0;
         for (size_t i = 0; i < n; i++) {
@@ -434,7 +436,7 @@ vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
         }
     }
     vf_localizer_close(run.loc);
-    vf_object_points_free(&run.object);
+    vf_field_free(run.field);
     vf_classifier_close(run.cls);
     vf_attack_file_free(&run.attack);
     json_decref(run.frames);
