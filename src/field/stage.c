@@ -183,6 +183,9 @@ static vf_status cut_field(vf_field *field, const vf_dataset *cut, int holdout,
         plane[k] = json_number_value(json_array_get(surface, (size_t)k));
     if (status == VF_OK && n == 0)
         status = vf_fail(VF_EINPUT, "object mode needs training views to cut the object out");
+    if (status == VF_OK && !has_plane) /* the wall clock: its face is the dominant plane */
+        vf_warn("object mode: no surface under the object was found, so the cut is the masks' "
+                "vote alone: look at WS/train/held_out.jpg once trained");
     if (status == VF_OK) {
         vf_info("cutting the object out of the field: %d views' masks vote%s", n,
                 has_plane ? ", the surface under it goes" : "");
