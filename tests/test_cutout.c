@@ -131,10 +131,54 @@ static void test_object_in_parts(void)
     vf_object_points_free(&p);
 }
 
+/* A wall clock: its flat face is the dominant plane, with a dense dial and a sparser case;
+ * what lies behind the face (its sides, the room reflected in its glass) outnumbers what
+ * lies in front, so the face is the object, not a support, and all of it is kept (single
+ * linkage kept the dense dial alone: 269 of the real clock's 1517 points). */
+static void test_object_face(void)
+{
+    static cloud c;
+    c.count = 0;
+    vf_rng rng;
+    vf_rng_seed(&rng, 5);
+    for (int i = 0; i < 700; i++) { /* the dial: a disc of radius 0.25, y = -0.1 */
+        double r = 0.25 * sqrt(vf_rng_uniform(&rng)), a = 2 * M_PI * vf_rng_uniform(&rng);
+        add(&c, r * cos(a), -0.1 + 0.004 * vf_rng_normal(&rng), 0.4 + r * sin(a));
+    }
+    int case_points = 0;
+    for (int i = 0; i < 2000 && case_points < 300; i++) { /* the case around it, sparse */
+        double x = vf_rng_uniform(&rng) - 0.5, z = 2 * vf_rng_uniform(&rng) - 1;
+        if (x * x + (z - 0.4) * (z - 0.4) > 0.3 * 0.3)
+            add(&c, x, -0.1 + 0.004 * vf_rng_normal(&rng), z), case_points++;
+    }
+    for (int i = 0; i < 250; i++) /* behind the face: sides, reflections */
+        add(&c, vf_rng_uniform(&rng) - 0.5, 0.1 + 0.5 * vf_rng_uniform(&rng),
+            2 * vf_rng_uniform(&rng) - 1);
+    double cameras[3 * 12];
+    for (int i = 0; i < 12; i++)
+        cameras[3 * i] = 2 * cos(i * 0.5), cameras[3 * i + 1] = -3.5, cameras[3 * i + 2] = sin(i);
+    vf_object_points p;
+    find_object(&c, cameras, 12, &p);
+    int face = 0, sparse = 0;
+    for (int i = 0; i < p.count; i++) {
+        const double *q = p.xyz + 3 * i;
+        face += fabs(q[1] + 0.1) < 0.02;
+        sparse += fabs(q[1] + 0.1) < 0.02 && q[0] * q[0] + (q[2] - 0.4) * (q[2] - 0.4) > 0.09;
+    }
+    printf("face: %d object points, %d on the face (%d of the case's %d), surface %d\n",
+           p.count, face, sparse, case_points, p.has_plane);
+    CHECK(!p.has_plane, "the face is no support");
+    CHECK(face > 0.95 * (700 + case_points) && sparse > 0.95 * case_points,
+          "the whole face: %d points, %d of the case", face, sparse);
+    CHECK(p.count - face < 25, "not what lies behind it: %d", p.count - face);
+    vf_object_points_free(&p);
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
     CHECK_CASE(test_wall_behind_the_origin);
     CHECK_CASE(test_object_in_parts);
+    CHECK_CASE(test_object_face);
     return check_finish();
 }

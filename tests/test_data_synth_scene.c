@@ -19,9 +19,12 @@
  *     centre) are localized against the workspace; their poses, with the ground truth mapped
  *     into the object frame by the training cameras' alignment, agree; c2w_colmap maps onto
  *     c2w_object by normalization.json; and the same scene with another texture is reported
- *     as not localized.
- * Limits are measured figures with room (see the comments at each check). About 20 s on 2
- * idle cores (COLMAP's matching is most of it), a minute on a busy machine. */
+ *     as not localized;
+ *   - cutout: the GrabCut masks of object mode against the box's true silhouettes;
+ *   - train_object: object mode end to end (a field trained on the photos, cut in 3D): its
+ *     silhouettes against the true ones.
+ * Limits are measured figures with room (see the comments at each check). About a minute on
+ * 2 idle cores (COLMAP's matching and object mode's 600 training steps are most of it). */
 #include <jansson.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -32,6 +35,7 @@
 #include "vf/camera.h"
 #include "vf/cutout.h"
 #include "vf/dataset.h"
+#include "vf/field.h"
 #include "vf/image.h"
 #include "vf/ingest.h"
 #include "vf/localize.h"
@@ -40,6 +44,7 @@
 #include "vf/poses.h"
 #include "vf/rgb8.h"
 #include "vf/rng.h"
+#include "vf/train.h"
 #include "vf/workspace.h"
 
 #define WIDTH 320
@@ -335,6 +340,7 @@ static vf_status render_rgb8(const texture *tex, const double c2w_gl[16], vf_rgb
  * photos: phi = 180 - elevation), distances 4 +- 0.25 alternating, so that the mean distance
  * is exactly 4 and every optical axis passes through the origin. */
 #define TRAIN_VIEWS 20
+#define OBJECT_STEPS 600 /* object mode's training (test_train_object) */
 static vf_viewpoint train_view(int i)
 {
     if (i < 12)
@@ -816,6 +822,92 @@ static void test_cutout(void)
     vf_dataset_free(&cut);
 }
 
+/* Object mode end to end (vf_train_run with object_only): a field trained on the whole
+ * photos, cut out in 3D by the training views' masks (vf_field_cut_object); its silhouette
+ * in every view (vf_field_silhouette, what score cuts re-captured frames by) against the
+ * box's true one. */
+static void test_train_object(void)
+{
+    build_workspace();
+    if (posed.built != 1)
+        return;
+    vf_train_options o;
+    vf_train_defaults(&o);
+    o.object_only = 1;
+    o.steps = OBJECT_STEPS;
+    vf_workspace w;
+    json_t *report = NULL;
+    double start = vf_now();
+    vf_status s = vf_workspace_open(posed.ws, 0, &w);
+    if (s == VF_OK) {
+        s = vf_train_run(&w, &o, &report);
+        vf_workspace_close(&w);
+    }
+    CHECK(s == VF_OK, "train --object-only: %s", vf_error_message());
+    if (s != VF_OK)
+        return;
+    const char *mode = json_string_value(json_object_get(report, "mode"));
+    json_t *cut = json_object_get(json_object_get(report, "cutout"), "field_cut");
+    printf("train --object-only: %d steps in %.1f s, mode %s, kept share %.3f, held-out PSNR "
+           "inside the silhouettes %.2f dB\n",
+           OBJECT_STEPS, vf_now() - start, mode ? mode : "?",
+           json_number_value(json_object_get(cut, "kept_share")),
+           json_number_value(json_object_get(report, "held_out_psnr_object")));
+    CHECK(mode && strcmp(mode, "object") == 0, "the report says object mode");
+    json_decref(report);
+
+    char path[VF_PATH_MAX];
+    vf_field *f = NULL;
+    vf_dataset views = {0};
+    vf_path_join(path, sizeof path, posed.ws, "train/" VF_FIELD_FILE);
+    s = vf_field_load(path, &f);
+    vf_path_join(path, sizeof path, posed.ws, "poses/transforms.json");
+    if (s == VF_OK)
+        s = vf_dataset_load(path, &views);
+    CHECK(s == VF_OK, "the field and its views: %s", vf_error_message());
+    uint8_t *truth = malloc(WIDTH * HEIGHT);
+    double iou_sum = 0, iou_min = 1;
+    int n = 0, good = 0;
+    for (int i = 0; s == VF_OK && truth && i < views.count; i++) {
+        const vf_frame *fr = &views.frames[i];
+        int k = view_index(fr->image_path);
+        uint8_t *sil = NULL;
+        if (k < 0 || !true_mask(k, truth) || fr->camera.width != WIDTH ||
+            fr->camera.height != HEIGHT ||
+            vf_field_silhouette(f, &fr->camera, fr->c2w, 0, &sil) != VF_OK) {
+            CHECK(0, "view %d: no silhouette to compare (%s)", i, fr->image_path);
+            free(sil);
+            continue;
+        }
+        int both = 0, either = 0;
+        for (int j = 0; j < WIDTH * HEIGHT; j++) {
+            both += sil[j] && truth[j];
+            either += sil[j] || truth[j];
+        }
+        free(sil);
+        const double iou = either ? (double)both / either : 0;
+        if (iou < 0.8)
+            printf("  view %d: intersection over union %.3f (%d pixels in both, %d in either)\n",
+                   k, iou, both, either);
+        good += iou > 0.8;
+        iou_sum += iou;
+        iou_min = iou < iou_min ? iou : iou_min;
+        n++;
+    }
+    free(truth);
+    printf("object mode: the field's silhouette against the true one, intersection over union "
+           "mean %.3f, worst %.3f, %d of %d views over 0.8\n",
+           n ? iou_sum / n : 0, iou_min, good, n);
+    CHECK(n == TRAIN_VIEWS, "every view compared (%d)", n);
+    /* measured over 4 runs: mean 0.878-0.886, 18 of 20 views over 0.8; the worst, view 2
+     * (0.35-0.36), has the pillar in front of the box, kept with it: a point is kept when
+     * most views that see it find it on the object, and most see the pillar before the box */
+    CHECK(n && iou_sum / n > 0.8, "mean IoU %.3f", n ? iou_sum / n : 0);
+    CHECK(good >= 3 * n / 4, "%d of %d views over 0.8", good, n);
+    vf_field_free(f);
+    vf_dataset_free(&views);
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
@@ -824,5 +916,6 @@ int main(int argc, char **argv)
     CHECK_CASE(test_poses);
     CHECK_CASE(test_localize);
     CHECK_CASE(test_cutout);
+    CHECK_CASE(test_train_object);
     return check_finish();
 }

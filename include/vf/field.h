@@ -129,11 +129,20 @@ typedef struct vf_field_cut_view {
  * their mask (a vote: a cut-out that errs in a view or two does not cut the object; a point
  * no view sees goes) and (b) with a plane (n.x + d = 0, n towards the cameras: the surface the
  * object stands on or hangs from; NULL for none), it lies at least `clearance` in front of it
- * (papers, a tablecloth, the wall's paint go with the surface). Everything else becomes empty
+ * (papers, a tablecloth, the wall's paint go with the surface). Then the scraps go: pieces
+ * of what is left (connected grid points) under 5% of the largest in the object grid, and
+ * pieces of the outer grid that do not reach the object box. Everything else becomes empty
  * space, and the background white, as for background-removed photos. *kept_share (may be
  * NULL) gets the share of visible grid points kept. Views' masks are read, not kept. */
 vf_status vf_field_cut_object(vf_field *f, const vf_field_cut_view *views, int n, double share,
                               const double *plane, double clearance, double *kept_share);
+
+/* The field's silhouette in the view of cam from c2w: *mask gets cam->width x cam->height
+ * bytes (malloc'd, row-major, 1 where the opacity is over a half), the mask of the object a
+ * cut field (vf_field_cut_object) holds. max_side > 0 renders the opacity at most that many
+ * pixels long and scales it up (nearest), for large frames; 0 renders at full size. */
+vf_status vf_field_silhouette(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                              int max_side, uint8_t **mask);
 
 /* ---- training ---------------------------------------------------------------------------- */
 

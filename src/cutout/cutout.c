@@ -210,10 +210,17 @@ vf_status vf_object_points_find(const char *points_dir, const double *cameras, i
         out->on_plane = n - kept;
         n = kept;
     }
-
-    /* the object: the cluster of what is left that lies at the centre of attention */
     int kept = 0;
-    status = central_cluster(cand, n, o->radius, &kept);
+    if (n > 0 && on_plane >= MIN_PLANE_SHARE * n && !out->has_plane) {
+        /* the plane is the object's face: its points, and those in front of it, are the
+         * object (clustering them would keep the densest patch only: the clock's dial) */
+        for (int i = 0; i < n; i++)
+            if (dot3(plane, cand + 3 * i) + plane[3] >= -o->plane_tolerance)
+                memmove(cand + 3 * kept++, cand + 3 * i, 3 * sizeof *cand);
+    } else {
+        /* the object: the cluster of what is left that lies at the centre of attention */
+        status = central_cluster(cand, n, o->radius, &kept);
+    }
     if (status != VF_OK) {
         free(cand);
         return status;

@@ -242,22 +242,23 @@ static vf_status sheet_tile(const vf_image *img, vf_image *out)
     return vf_image_resize(img, w > 0 ? w : 1, SHEET_HEIGHT, out);
 }
 
-/* Object mode: the photo with the field's silhouette (opacity over a half) as its alpha, the
- * object's mask in a held-out view. */
+/* Object mode: the photo with the field's silhouette as its alpha, the object's mask in a
+ * held-out view. */
 static vf_status silhouette_cutout(const vf_field *f, const vf_frame *frame, vf_image *photo)
 {
-    vf_image opacity = {0}, rgba = {0};
-    vf_status status = vf_field_render_opacity(f, &frame->camera, frame->c2w, &opacity);
-    if (status == VF_OK && (photo->channels != 3 || photo->width != opacity.width ||
-                            photo->height != opacity.height))
-        status = vf_fail(VF_EINPUT, "%s is not the size of its camera", frame->image_path);
+    if (photo->channels != 3 || photo->width != frame->camera.width ||
+        photo->height != frame->camera.height)
+        return vf_fail(VF_EINPUT, "%s is not the size of its camera", frame->image_path);
+    uint8_t *mask = NULL;
+    vf_image rgba = {0};
+    vf_status status = vf_field_silhouette(f, &frame->camera, frame->c2w, 0, &mask);
     if (status == VF_OK)
         status = vf_image_alloc(&rgba, photo->width, photo->height, 4);
     for (size_t p = 0; status == VF_OK && p < (size_t)photo->width * photo->height; p++) {
         memcpy(rgba.data + 4 * p, photo->data + 3 * p, 3 * sizeof(float));
-        rgba.data[4 * p + 3] = opacity.data[p] > 0.5f;
+        rgba.data[4 * p + 3] = mask[p];
     }
-    vf_image_free(&opacity);
+    free(mask);
     if (status == VF_OK) {
         vf_image_free(photo);
         *photo = rgba;

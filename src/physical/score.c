@@ -122,29 +122,8 @@ static vf_status open_object_mode(score_run *run, const vf_workspace *ws)
     return status;
 }
 
-/* The field's silhouette (opacity over a half) in a frame seen by cam from c2w: *mask gets
- * width x height bytes (1 on the object). Rendered at most SILHOUETTE_SIDE pixels long. */
+/* Frames are cut by the field's silhouette rendered at most this many pixels long. */
 #define SILHOUETTE_SIDE 480
-static vf_status silhouette_mask(const vf_field *field, const vf_camera *cam,
-                                 const double c2w[16], uint8_t **mask)
-{
-    const int w = cam->width, h = cam->height, longer = w > h ? w : h;
-    const double scale = longer > SILHOUETTE_SIDE ? (double)SILHOUETTE_SIDE / longer : 1.0;
-    const int sw = (int)lround(w * scale) > 0 ? (int)lround(w * scale) : 1;
-    const int sh = (int)lround(h * scale) > 0 ? (int)lround(h * scale) : 1;
-    const vf_camera small = vf_camera_scaled(cam, sw, sh);
-    vf_image opacity = {0};
-    vf_status status = vf_field_render_opacity(field, &small, c2w, &opacity);
-    if (status == VF_OK && !(*mask = malloc((size_t)w * h)))
-        status = vf_fail(VF_EINTERNAL, "out of memory");
-    for (int y = 0; status == VF_OK && y < h; y++)
-        for (int x = 0; x < w; x++) {
-            const int sx = (int)((x + 0.5) * sw / w), sy = (int)((y + 0.5) * sh / h);
-            (*mask)[(size_t)y * w + x] = opacity.data[(size_t)sy * sw + sx] > 0.5f;
-        }
-    vf_image_free(&opacity);
-    return status;
-}
 
 /* The classifier's centre square of img (the crop vf_classifier_preprocess takes), small. */
 static vf_status thumbnail(const vf_image *img, vf_image *out)
@@ -173,7 +152,7 @@ static vf_status classify(score_run *run, const vf_rgb8 *frame, const double c2w
     vf_camera cam;
     if (status == VF_OK && run->object_mode &&
         (status = vf_localizer_camera(run->loc, frame->width, frame->height, &cam)) == VF_OK)
-        status = silhouette_mask(run->field, &cam, c2w, &mask);
+        status = vf_field_silhouette(run->field, &cam, c2w, SILHOUETTE_SIDE, &mask);
     if (status == VF_OK) {
         size_t n = (size_t)frame->width * frame->height, on = 0;
         for (size_t i = 0; i < n; i++) {
