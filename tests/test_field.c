@@ -654,6 +654,24 @@ static void test_box_on_central_points(void)
  * (clutter) on a slab (the surface). Six views' masks are discs round A's projection, one
  * of them empty (a failed cut-out): the vote keeps all of A and drops B; the slab under A,
  * inside most masks, goes with the plane only; the silhouette is A's. */
+/* The mask of a ball (centre, radius) in the view of cam from c2w: its disc, `scale` times
+ * as wide (a cut-out with a margin: 1.3). */
+static void ball_mask(const vf_camera *cam, const double c2w[16], const double centre[3],
+                      double radius, double scale, uint8_t *mask)
+{
+    double rot[9], t[3], pc[3], u, w;
+    vf_c2w_gl_to_w2c_cv(c2w, rot, t);
+    vf_mat3_apply(rot, centre, pc);
+    for (int k = 0; k < 3; k++)
+        pc[k] += t[k];
+    vf_camera_project(cam, pc, &u, &w);
+    const double r = scale * cam->fx * radius / pc[2];
+    for (int y = 0; y < cam->height; y++)
+        for (int x = 0; x < cam->width; x++)
+            mask[y * cam->width + x] =
+                (x + 0.5 - u) * (x + 0.5 - u) + (y + 0.5 - w) * (y + 0.5 - w) < r * r;
+}
+
 static void test_object_cut(void)
 {
     enum { VIEWS = 6, SIDE = 64 };
@@ -666,17 +684,9 @@ static void test_object_cut(void)
         views[i].camera = cam;
         vf_viewpoint_to_c2w(&v, views[i].c2w);
         views[i].mask = masks[i];
-        double rot[9], t[3], pc[3], u, w;
-        vf_c2w_gl_to_w2c_cv(views[i].c2w, rot, t);
-        vf_mat3_apply(rot, a_centre, pc);
-        for (int k = 0; k < 3; k++)
-            pc[k] += t[k];
-        vf_camera_project(&cam, pc, &u, &w);
-        const double r = 1.3 * cam.fx * 0.25 / pc[2]; /* A's radius in pixels, with a margin */
-        for (int y = 0; y < SIDE; y++)
-            for (int x = 0; x < SIDE; x++)
-                masks[i][y * SIDE + x] =
-                    i != 2 && (x + 0.5 - u) * (x + 0.5 - u) + (y + 0.5 - w) * (y + 0.5 - w) < r * r;
+        ball_mask(&cam, views[i].c2w, a_centre, 0.25, 1.3, masks[i]);
+        if (i == 2)
+            memset(masks[i], 0, sizeof masks[i]);
     }
     /* z = 0: A reaches down to -0.05, so the plane and its clearance of 0.02 take A's bottom */
     const double plane[4] = {0, 0, 1, 0};
@@ -762,6 +772,74 @@ static void test_object_cut(void)
         vf_image_free(&opacity);
         vf_field_free(f);
     }
+}
+
+/* Object mode without a support plane (a wall clock: its wall has no points): a view votes
+ * on a point only where it sees it. Ball A before a wall, every view from the front: the
+ * wall behind A lies inside A's mask (its exact disc) in every view, but the views in which
+ * A hides it have no say, and those that see it see it beside A: all of it goes. */
+static void test_object_cut_hidden(void)
+{
+    enum { VIEWS = 5, SIDE = 64 };
+    const vf_camera cam = {.width = SIDE, .height = SIDE, .fx = 80, .fy = 80, .cx = 32, .cy = 32};
+    const double a_centre[3] = {-0.4, 0.1, 0.2}; /* make_sparse_field's first ball */
+    vf_field_cut_view views[VIEWS];
+    static uint8_t masks[VIEWS][SIDE * SIDE];
+    double towards[3] = {0, 0, 0}; /* the cameras' mean direction from A */
+    for (int i = 0; i < VIEWS; i++) {
+        const vf_viewpoint v = {.psi = 15.0 * (i - 2), .theta = 20};
+        views[i].camera = cam;
+        vf_viewpoint_to_c2w(&v, views[i].c2w);
+        views[i].mask = masks[i];
+        ball_mask(&cam, views[i].c2w, a_centre, 0.25, 1.0, masks[i]);
+        for (int k = 0; k < 3; k++)
+            towards[k] += views[i].c2w[4 * k + 3] - a_centre[k];
+    }
+    const double len = sqrt(towards[0] * towards[0] + towards[1] * towards[1] +
+                            towards[2] * towards[2]);
+    vf_field *f = make_sparse_field();
+    field_grid *g = &f->grids[0];
+    const float d_min =
+        vf__field_density_threshold(f, FIELD_VISIBLE_ALPHA, f->step_ratio * g->voxel);
+    int wall = 0, wall_kept = 0, behind = 0, behind_kept = 0, front = 0, front_kept = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t i = 0; i < g->points; i++) {
+            const double p[3] = {g->lo[0] + g->voxel * (double)(i % 48),
+                                 g->lo[1] + g->voxel * (double)(i / 48 % 48),
+                                 g->lo[2] + g->voxel * (double)(i / (48 * 48))};
+            double along = 0, r2 = 0;
+            for (int k = 0; k < 3; k++)
+                along += (p[k] - a_centre[k]) * towards[k] / len;
+            for (int k = 0; k < 3; k++) {
+                const double off = p[k] - a_centre[k] - along * towards[k] / len;
+                r2 += off * off;
+            }
+            float *d = &g->values[i * FIELD_CH + FIELD_CH_DENSITY];
+            const int in_wall = along > -0.55 && along < -0.4 && r2 < 0.45 * 0.45;
+            const int in_front = along > 0.05 && r2 + along * along < 0.25 * 0.25;
+            if (pass == 0 && in_wall)
+                *d = 2.0f; /* the wall, a slab behind A as the cameras see it */
+            if (pass == 1) {
+                wall += in_wall, wall_kept += in_wall && *d >= d_min;
+                behind += in_wall && r2 < 0.2 * 0.2;
+                behind_kept += in_wall && r2 < 0.2 * 0.2 && *d >= d_min;
+                front += in_front, front_kept += in_front && *d >= d_min;
+            }
+        }
+        if (pass == 0) {
+            vf__field_grid_update_occupancy(g, f, f->step_ratio * g->voxel);
+            CHECK(vf_field_cut_object(f, views, VIEWS, 0.5, NULL, 0.02, NULL) == VF_OK,
+                  "cut: %s", vf_error_message());
+        }
+    }
+    printf("object cut, no plane, views from the front: wall %d of %d points kept (%d of the %d "
+           "right behind A), A's front %d of %d\n",
+           wall_kept, wall, behind_kept, behind, front_kept, front);
+    CHECK(behind > 100 && behind_kept == 0, "the wall behind A goes (%d of %d points left)",
+          behind_kept, behind);
+    CHECK(wall_kept < 0.05 * wall, "the wall goes (%d of %d points left)", wall_kept, wall);
+    CHECK(front > 50 && front_kept == front, "A's front stays (%d of %d)", front_kept, front);
+    vf_field_free(f);
 }
 
 static void test_checkpoint_resume(void)
@@ -964,6 +1042,7 @@ int main(int argc, char **argv)
     CHECK_CASE(test_outer_grid_reach);
     CHECK_CASE(test_box_on_central_points);
     CHECK_CASE(test_object_cut);
+    CHECK_CASE(test_object_cut_hidden);
     CHECK_CASE(test_checkpoint_resume);
     CHECK_CASE(test_color_models);
     CHECK_CASE(test_automatic_options);

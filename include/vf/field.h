@@ -129,9 +129,15 @@ typedef struct vf_field_cut_view {
  * their mask (a vote: a cut-out that errs in a view or two does not cut the object; a point
  * no view sees goes) and (b) with a plane (n.x + d = 0, n towards the cameras: the surface the
  * object stands on or hangs from; NULL for none), it lies at least `clearance` in front of it
- * (papers, a tablecloth, the wall's paint go with the surface). Then the scraps go: pieces
- * of what is left (connected grid points) under 5% of the largest in the object grid, and
- * pieces of the outer grid that do not reach the object box. Everything else becomes empty
+ * (papers, a tablecloth, the wall's paint go with the surface). Without a plane a view
+ * votes on a point only where it sees it, not hidden behind the field's surface (a wall
+ * behind the object lies inside the masks of the views the object hides it from: they have
+ * no say); with one, every view with the point in its picture votes (the views that see the
+ * object's far side through it find that side inside their masks, and outvote the masks'
+ * errors: visibility took the fox's held-out PSNR inside its masks from 15.6 to 12.9 dB).
+ * Then the scraps go: pieces of what is left (connected grid points) under 5% of the
+ * largest in the object grid, and pieces of the outer grid that do not reach the object box.
+ * Everything else becomes empty
  * space, and the background white, as for background-removed photos. *kept_share (may be
  * NULL) gets the share of visible grid points kept. Views' masks are read, not kept. */
 vf_status vf_field_cut_object(vf_field *f, const vf_field_cut_view *views, int n, double share,

@@ -7,14 +7,66 @@
 
 #include "field_internal.h"
 
-/* One view's camera as a projection: world to OpenCV camera axes, then pixels. */
+/* Without a support plane (a wall clock's wall has no points to find it by), a view votes on
+ * a point only where it sees it: no farther from the camera than the field's surface at its
+ * pixel plus this many voxels of the object grid. The surface comes from a depth map rendered
+ * this many pixels long. The wall clock (4500-step field, every 8th view held out): its
+ * held-out silhouettes reach outside their GrabCut masks by 107% of the masks' area without
+ * this, 9.8% with it (margins of 10 and 25 voxels: 13.8, 23.7%); PSNR against the cut-out
+ * photos on white 12.2 -> 15.4 dB, inside the masks 18.5 -> 11.8 dB (holes in its glass and
+ * case); its renders named like the cut-out photos 50 -> 62% (42 views). With a plane it
+ * costs the object (the views that see a point hidden behind the object find it inside their
+ * mask, and outvote the masks' errors): the fox 15.6 -> 12.9 dB inside its masks. */
+#define VISIBLE_MARGIN_VOXELS 4.0
+#define DEPTH_SIDE 320
+
+/* One view's camera as a projection (world to OpenCV camera axes, then pixels), and, when
+ * visibility counts, what it sees: the distance to the field's surface at each pixel of a
+ * small depth map (infinite where the view sees through the field). */
 typedef struct cut_camera {
     double rot[9], t[3];
+    float *depth; /* NULL: every point in the picture counts as seen */
+    int depth_w, depth_h;
 } cut_camera;
+
+/* The view's depth map of the uncut field: the opacity-weighted mean distance of the samples
+ * along each pixel's ray, where the field is more than half opaque. */
+static vf_status depth_map(const vf_field *f, const field_render_setup *setup,
+                           const vf_field_cut_view *view, cut_camera *c)
+{
+    const vf_camera *cam = &view->camera;
+    const int longer = cam->width > cam->height ? cam->width : cam->height;
+    const double scale = longer > DEPTH_SIDE ? (double)DEPTH_SIDE / longer : 1.0;
+    c->depth_w = (int)lround(cam->width * scale) > 0 ? (int)lround(cam->width * scale) : 1;
+    c->depth_h = (int)lround(cam->height * scale) > 0 ? (int)lround(cam->height * scale) : 1;
+    const vf_camera small = scale < 1.0 ? vf_camera_scaled(cam, c->depth_w, c->depth_h) : *cam;
+    c->depth = malloc((size_t)c->depth_w * c->depth_h * sizeof *c->depth);
+    if (!c->depth)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    const int w = c->depth_w;
+#pragma omp parallel for schedule(dynamic, 2)
+    for (int y = 0; y < c->depth_h; y++) {
+        enum { RUN = 64 };
+        for (int x0 = 0; x0 < w; x0 += RUN) {
+            const int n = w - x0 < RUN ? w - x0 : RUN;
+            field_ray rays[RUN];
+            field_march_result res[RUN];
+            for (int j = 0; j < n; j++)
+                vf__field_camera_ray(&small, view->c2w, x0 + j + 0.5, y + 0.5, &rays[j]);
+            vf__field_render_rays(f, setup, rays, n, 0.5f, f->stop_transmittance, res);
+            for (int j = 0; j < n; j++) {
+                const float opacity = 1.0f - res[j].trans;
+                c->depth[(size_t)y * w + x0 + j] =
+                    opacity > 0.5f ? res[j].depth / opacity : INFINITY;
+            }
+        }
+    }
+    return VF_OK;
+}
 
 /* Whether the views that see p mostly find it on the object: 1 to keep it. */
 static int votes_to_keep(const vf_field_cut_view *views, const cut_camera *cams, int n,
-                         const double p[3], double share)
+                         const double p[3], double share, double margin)
 {
     int seen = 0, outside = 0;
     for (int i = 0; i < n; i++) {
@@ -27,6 +79,12 @@ static int votes_to_keep(const vf_field_cut_view *views, const cut_camera *cams,
         if (!vf_camera_project(c, pc, &u, &v) ||
             !(u >= 0 && v >= 0 && u < c->width && v < c->height))
             continue;
+        if (cams[i].depth) { /* hidden behind the surface: the view cannot tell */
+            const size_t d = (size_t)(v * cams[i].depth_h / c->height) * cams[i].depth_w +
+                             (size_t)(u * cams[i].depth_w / c->width);
+            if (sqrt(pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2]) > cams[i].depth[d] + margin)
+                continue;
+        }
         seen++;
         outside += !views[i].mask[(size_t)v * c->width + (size_t)u];
     }
@@ -134,18 +192,26 @@ vf_status vf_field_cut_object(vf_field *f, const vf_field_cut_view *views, int n
     for (int i = 0; i < n; i++)
         if (views[i].camera.width < 1 || views[i].camera.height < 1 || !views[i].mask)
             return vf_fail(VF_EINTERNAL, "view %d of the object cut has no mask", i);
-    cut_camera *cams = malloc((size_t)n * sizeof *cams);
+    cut_camera *cams = calloc((size_t)n, sizeof *cams);
     if (!cams)
         return vf_fail(VF_EINTERNAL, "out of memory");
-    for (int i = 0; i < n; i++)
+    field_render_setup setup;
+    vf__field_render_setup_init(f, &setup);
+    vf_status status = VF_OK;
+    const int visibility = !plane;
+    for (int i = 0; i < n && status == VF_OK; i++) {
         vf_c2w_gl_to_w2c_cv(views[i].c2w, cams[i].rot, cams[i].t);
+        if (visibility)
+            status = depth_map(f, &setup, &views[i], &cams[i]);
+    }
+    const double margin = VISIBLE_MARGIN_VOXELS * f->grids[0].voxel;
     size_t kept = 0, visible = 0;
     for (int gi = 0; gi < f->grid_count; gi++) {
         field_grid *g = &f->grids[gi];
         const float d_min =
             vf__field_density_threshold(f, FIELD_VISIBLE_ALPHA, f->step_ratio * g->voxel);
 #pragma omp parallel for schedule(dynamic) reduction(+ : kept, visible)
-        for (int z = 0; z < g->dim[2]; z++)
+        for (int z = 0; z < (status == VF_OK ? g->dim[2] : 0); z++)
             for (int y = 0; y < g->dim[1]; y++)
                 for (int x = 0; x < g->dim[0]; x++) {
                     float *d = &g->values[(((size_t)z * g->dim[1] + y) * g->dim[0] + x) * FIELD_CH +
@@ -157,16 +223,19 @@ vf_status vf_field_cut_object(vf_field *f, const vf_field_cut_view *views, int n
                                          g->lo[2] + z * g->voxel};
                     int keep = !plane || plane[0] * p[0] + plane[1] * p[1] + plane[2] * p[2] +
                                                  plane[3] >= clearance;
-                    keep = keep && votes_to_keep(views, cams, n, p, share);
+                    keep = keep && votes_to_keep(views, cams, n, p, share, margin);
                     if (keep)
                         kept++;
                     else
                         *d = FIELD_EMPTY_DENSITY;
                 }
     }
+    for (int i = 0; i < n; i++)
+        free(cams[i].depth);
     free(cams);
     size_t dropped = 0;
-    vf_status status = drop_scraps(f, &dropped);
+    if (status == VF_OK)
+        status = drop_scraps(f, &dropped);
     if (status != VF_OK)
         return status;
     kept -= dropped;
