@@ -758,6 +758,40 @@ static int true_mask(int i, uint8_t *mask)
     return on;
 }
 
+/* Masks against the true silhouettes, view by view: intersection over union. */
+typedef struct iou_tally {
+    double sum, min;
+    int n, good; /* views, and those over 0.8 */
+} iou_tally;
+
+/* Add a view: ours and truth are WIDTH x HEIGHT, nonzero on the object. Returns its IoU. */
+static double iou_add(iou_tally *t, const uint8_t *ours, const uint8_t *truth)
+{
+    int both = 0, either = 0;
+    for (int j = 0; j < WIDTH * HEIGHT; j++) {
+        both += ours[j] && truth[j];
+        either += ours[j] || truth[j];
+    }
+    const double iou = either ? (double)both / either : 0;
+    t->min = t->n == 0 || iou < t->min ? iou : t->min;
+    t->sum += iou;
+    t->good += iou > 0.8;
+    t->n++;
+    return iou;
+}
+
+/* Print the tally as `what` and check it: every view compared, a mean over 0.8, and three
+ * views in four over 0.8. */
+static void iou_check(const iou_tally *t, const char *what)
+{
+    printf("%s: intersection over union with the true silhouettes, mean %.3f, worst %.3f, %d "
+           "of %d views over 0.8\n",
+           what, t->n ? t->sum / t->n : 0, t->min, t->good, t->n);
+    CHECK(t->n == TRAIN_VIEWS, "%s: every view compared (%d)", what, t->n);
+    CHECK(t->n && t->sum / t->n > 0.8, "%s: mean IoU %.3f", what, t->n ? t->sum / t->n : 0);
+    CHECK(t->good >= 3 * t->n / 4, "%s: %d of %d views over 0.8", what, t->good, t->n);
+}
+
 /* Object mode: the central box cut out of every training view (vf_cutout_views, from the
  * workspace's sparse points) against its true silhouette from the ray caster. */
 static void test_cutout(void)
@@ -784,39 +818,28 @@ static void test_cutout(void)
            json_integer_value(json_object_get(report, "on_surface")), vf_now() - start);
     CHECK(json_is_true(json_object_get(report, "surface_found")), "the ground is found");
     uint8_t *truth = malloc(WIDTH * HEIGHT);
-    double iou_sum = 0, iou_min = 1;
-    int n = 0, good = 0;
-    for (int i = 0; s == VF_OK && truth && i < cut.count; i++) {
+    iou_tally t = {0};
+    uint8_t *ours = malloc(WIDTH * HEIGHT);
+    for (int i = 0; s == VF_OK && truth && ours && i < cut.count; i++) {
         int k = view_index(views.frames[i].image_path);
         vf_image rgba = {0};
         if (k < 0 || !true_mask(k, truth) ||
-            vf_image_load(cut.frames[i].image_path, &rgba) != VF_OK || rgba.channels != 4) {
+            vf_image_load(cut.frames[i].image_path, &rgba) != VF_OK || rgba.channels != 4 ||
+            rgba.width != WIDTH || rgba.height != HEIGHT) {
             CHECK(0, "view %d: no mask to compare (%s)", i, cut.frames[i].image_path);
             vf_image_free(&rgba);
             continue;
         }
-        int both = 0, either = 0;
-        for (int j = 0; j < WIDTH * HEIGHT; j++) {
-            int ours = rgba.data[4 * j + 3] > 0.5f;
-            both += ours && truth[j];
-            either += ours || truth[j];
-        }
-        double iou = either ? (double)both / either : 0;
-        good += iou > 0.8;
-        iou_sum += iou;
-        iou_min = iou < iou_min ? iou : iou_min;
-        n++;
+        for (int j = 0; j < WIDTH * HEIGHT; j++)
+            ours[j] = rgba.data[4 * j + 3] > 0.5f;
+        iou_add(&t, ours, truth);
         vf_image_free(&rgba);
     }
     free(truth);
-    printf("cutout: intersection over union with the true silhouette, mean %.3f, worst %.3f, "
-           "%d of %d views over 0.8\n",
-           n ? iou_sum / n : 0, iou_min, good, n);
-    CHECK(n == TRAIN_VIEWS, "every view compared (%d)", n);
+    free(ours);
     /* measured: mean 0.90-0.92, 18-19 of 20 over 0.8 (a view or two lose a face to the
      * ground's colours: 0.28-0.32) */
-    CHECK(n && iou_sum / n > 0.8, "mean IoU %.3f", n ? iou_sum / n : 0);
-    CHECK(good >= 3 * n / 4, "%d of %d views over 0.8", good, n);
+    iou_check(&t, "cutout");
     json_decref(report);
     vf_dataset_free(&views);
     vf_dataset_free(&cut);
@@ -866,8 +889,7 @@ static void test_train_object(void)
         s = vf_dataset_load(path, &views);
     CHECK(s == VF_OK, "the field and its views: %s", vf_error_message());
     uint8_t *truth = malloc(WIDTH * HEIGHT);
-    double iou_sum = 0, iou_min = 1;
-    int n = 0, good = 0;
+    iou_tally t = {0};
     for (int i = 0; s == VF_OK && truth && i < views.count; i++) {
         const vf_frame *fr = &views.frames[i];
         int k = view_index(fr->image_path);
@@ -879,31 +901,16 @@ static void test_train_object(void)
             free(sil);
             continue;
         }
-        int both = 0, either = 0;
-        for (int j = 0; j < WIDTH * HEIGHT; j++) {
-            both += sil[j] && truth[j];
-            either += sil[j] || truth[j];
-        }
-        free(sil);
-        const double iou = either ? (double)both / either : 0;
+        const double iou = iou_add(&t, sil, truth);
         if (iou < 0.8)
-            printf("  view %d: intersection over union %.3f (%d pixels in both, %d in either)\n",
-                   k, iou, both, either);
-        good += iou > 0.8;
-        iou_sum += iou;
-        iou_min = iou < iou_min ? iou : iou_min;
-        n++;
+            printf("  view %d: intersection over union %.3f\n", k, iou);
+        free(sil);
     }
     free(truth);
-    printf("object mode: the field's silhouette against the true one, intersection over union "
-           "mean %.3f, worst %.3f, %d of %d views over 0.8\n",
-           n ? iou_sum / n : 0, iou_min, good, n);
-    CHECK(n == TRAIN_VIEWS, "every view compared (%d)", n);
     /* measured over 4 runs: mean 0.878-0.886, 18 of 20 views over 0.8; the worst, view 2
      * (0.35-0.36), has the pillar in front of the box, kept with it: a point is kept when
      * most views that see it find it on the object, and most see the pillar before the box */
-    CHECK(n && iou_sum / n > 0.8, "mean IoU %.3f", n ? iou_sum / n : 0);
-    CHECK(good >= 3 * n / 4, "%d of %d views over 0.8", good, n);
+    iou_check(&t, "object mode, the field's silhouettes");
     vf_field_free(f);
     vf_dataset_free(&views);
 }

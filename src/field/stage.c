@@ -184,8 +184,9 @@ static vf_status cut_field(vf_field *field, const vf_dataset *cut, int holdout,
     if (status == VF_OK && n == 0)
         status = vf_fail(VF_EINPUT, "object mode needs training views to cut the object out");
     if (status == VF_OK && !has_plane) /* the wall clock: its face is the dominant plane */
-        vf_warn("object mode: no surface under the object was found, so the cut is the masks' "
-                "vote alone: look at WS/train/held_out.jpg once trained");
+        vf_warn("object mode: no surface under the object was found, so nothing is cut away "
+                "with it (the views vote only on what they see): look at WS/train/held_out.jpg "
+                "once trained");
     if (status == VF_OK) {
         vf_info("cutting the object out of the field: %d views' masks vote%s", n,
                 has_plane ? ", the surface under it goes" : "");
