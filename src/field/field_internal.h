@@ -302,6 +302,12 @@ typedef struct field_render_setup {
 
 void vf__field_render_setup_init(const vf_field *f, field_render_setup *setup);
 
+/* The distance to the surface each pixel of the view sees (camera width x height floats):
+ * the opacity-weighted mean distance of its samples where the opacity is over a half, else
+ * infinity. Rows spread over the cores (render.c). */
+void vf__field_render_depth(const vf_field *f, const field_render_setup *setup,
+                            const vf_camera *cam, const double c2w[16], float *depth);
+
 /* The opacity of a sample of raw density d >= visible_density, from the grid's table. The
  * index is clamped both ways (and a NaN takes the last entry), so no value can read outside
  * the table. */

@@ -29,38 +29,28 @@ typedef struct cut_camera {
     int depth_w, depth_h;
 } cut_camera;
 
-/* The view's depth map of the uncut field: the opacity-weighted mean distance of the samples
- * along each pixel's ray, where the field is more than half opaque. */
+/* cam scaled down so its longer side is at most `side` pixels (0: as it is). */
+static vf_camera camera_at_most(const vf_camera *cam, int side)
+{
+    const int longer = cam->width > cam->height ? cam->width : cam->height;
+    if (side <= 0 || longer <= side)
+        return *cam;
+    const double scale = (double)side / longer;
+    const int w = (int)lround(cam->width * scale), h = (int)lround(cam->height * scale);
+    return vf_camera_scaled(cam, w > 0 ? w : 1, h > 0 ? h : 1);
+}
+
+/* The view's depth map of the uncut field, DEPTH_SIDE pixels long at most. */
 static vf_status depth_map(const vf_field *f, const field_render_setup *setup,
                            const vf_field_cut_view *view, cut_camera *c)
 {
-    const vf_camera *cam = &view->camera;
-    const int longer = cam->width > cam->height ? cam->width : cam->height;
-    const double scale = longer > DEPTH_SIDE ? (double)DEPTH_SIDE / longer : 1.0;
-    c->depth_w = (int)lround(cam->width * scale) > 0 ? (int)lround(cam->width * scale) : 1;
-    c->depth_h = (int)lround(cam->height * scale) > 0 ? (int)lround(cam->height * scale) : 1;
-    const vf_camera small = scale < 1.0 ? vf_camera_scaled(cam, c->depth_w, c->depth_h) : *cam;
+    const vf_camera small = camera_at_most(&view->camera, DEPTH_SIDE);
+    c->depth_w = small.width;
+    c->depth_h = small.height;
     c->depth = malloc((size_t)c->depth_w * c->depth_h * sizeof *c->depth);
     if (!c->depth)
         return vf_fail(VF_EINTERNAL, "out of memory");
-    const int w = c->depth_w;
-#pragma omp parallel for schedule(dynamic, 2)
-    for (int y = 0; y < c->depth_h; y++) {
-        enum { RUN = 64 };
-        for (int x0 = 0; x0 < w; x0 += RUN) {
-            const int n = w - x0 < RUN ? w - x0 : RUN;
-            field_ray rays[RUN];
-            field_march_result res[RUN];
-            for (int j = 0; j < n; j++)
-                vf__field_camera_ray(&small, view->c2w, x0 + j + 0.5, y + 0.5, &rays[j]);
-            vf__field_render_rays(f, setup, rays, n, 0.5f, f->stop_transmittance, res);
-            for (int j = 0; j < n; j++) {
-                const float opacity = 1.0f - res[j].trans;
-                c->depth[(size_t)y * w + x0 + j] =
-                    opacity > 0.5f ? res[j].depth / opacity : INFINITY;
-            }
-        }
-    }
+    vf__field_render_depth(f, setup, &small, view->c2w, c->depth);
     return VF_OK;
 }
 
@@ -252,11 +242,9 @@ vf_status vf_field_silhouette(const vf_field *f, const vf_camera *cam, const dou
                               int max_side, uint8_t **mask)
 {
     *mask = NULL;
-    const int w = cam->width, h = cam->height, longer = w > h ? w : h;
-    const double scale = max_side > 0 && longer > max_side ? (double)max_side / longer : 1.0;
-    const int sw = (int)lround(w * scale) > 0 ? (int)lround(w * scale) : 1;
-    const int sh = (int)lround(h * scale) > 0 ? (int)lround(h * scale) : 1;
-    const vf_camera small = scale < 1.0 ? vf_camera_scaled(cam, sw, sh) : *cam;
+    const int w = cam->width, h = cam->height;
+    const vf_camera small = camera_at_most(cam, max_side);
+    const int sw = small.width, sh = small.height;
     vf_image opacity = {0};
     vf_status status = vf_field_render_opacity(f, &small, c2w, &opacity);
     if (status == VF_OK && !(*mask = malloc((size_t)w * h)))

@@ -59,11 +59,15 @@ static vf_status check_poses(const double *c2w, int n)
     return VF_OK;
 }
 
-/* Render one image into rgb (3 floats a pixel; or, when opacity is given, its opacity there
- * instead, 1 float a pixel) with the field's render setup (made once for a batch of images).
- * Runs in the calling thread; `parallel` spreads rows over the cores. */
+/* What a render writes a pixel: its colour (3 floats), its opacity, or the distance to the
+ * surface it sees (the opacity-weighted mean distance of its samples where the opacity is
+ * over a half, else infinity). */
+typedef enum render_output { RENDER_RGB, RENDER_OPACITY, RENDER_DEPTH } render_output;
+
+/* Render one image into out (as `what` says) with the field's render setup (made once for a
+ * batch of images). Runs in the calling thread; `parallel` spreads rows over the cores. */
 static void render_rows(const vf_field *f, const field_render_setup *setup, const vf_camera *cam,
-                        const double c2w[16], float *rgb, float *opacity, int parallel)
+                        const double c2w[16], render_output what, float *out, int parallel)
 {
     enum { RUN = 64 }; /* pixels of a row marched together (vf__field_render_rays) */
     const int width = cam->width, height = cam->height;
@@ -78,13 +82,22 @@ static void render_rows(const vf_field *f, const field_render_setup *setup, cons
             vf__field_render_rays(f, setup, rays, n, 0.5f, f->stop_transmittance, res);
             for (int j = 0; j < n; j++) {
                 const size_t i = (size_t)y * width + x0 + j;
-                if (opacity)
-                    opacity[i] = 1.0f - res[j].trans;
+                const float opacity = 1.0f - res[j].trans;
+                if (what == RENDER_RGB)
+                    memcpy(out + 3 * i, res[j].rgb, sizeof res[j].rgb);
+                else if (what == RENDER_OPACITY)
+                    out[i] = opacity;
                 else
-                    memcpy(rgb + 3 * i, res[j].rgb, sizeof res[j].rgb);
+                    out[i] = opacity > 0.5f ? res[j].depth / opacity : INFINITY;
             }
         }
     }
+}
+
+void vf__field_render_depth(const vf_field *f, const field_render_setup *setup,
+                            const vf_camera *cam, const double c2w[16], float *depth)
+{
+    render_rows(f, setup, cam, c2w, RENDER_DEPTH, depth, 1);
 }
 
 /* One image, its rows spread over the cores: colour (3 channels) or opacity (1). */
@@ -99,8 +112,7 @@ static vf_status render_one(const vf_field *f, const vf_camera *cam, const doubl
     if (status == VF_OK) {
         field_render_setup setup;
         vf__field_render_setup_init(f, &setup);
-        render_rows(f, &setup, cam, c2w, opacity ? NULL : out->data, opacity ? out->data : NULL,
-                    1);
+        render_rows(f, &setup, cam, c2w, opacity ? RENDER_OPACITY : RENDER_RGB, out->data, 1);
     }
     return status;
 }
@@ -134,10 +146,10 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
     if ((size_t)cam->width * cam->height <= 512 * 512 && n > 1) {
 #pragma omp parallel for schedule(dynamic, 1)
         for (int i = 0; i < n; i++)
-            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, NULL, 0);
+            render_rows(f, &setup, cam, c2w + 16 * i, RENDER_RGB, out[i].data, 0);
     } else {
         for (int i = 0; i < n; i++)
-            render_rows(f, &setup, cam, c2w + 16 * i, out[i].data, NULL, 1);
+            render_rows(f, &setup, cam, c2w + 16 * i, RENDER_RGB, out[i].data, 1);
     }
     return VF_OK;
 }
