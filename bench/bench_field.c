@@ -18,8 +18,10 @@
  * are wall clock on all cores; expect +-10% when other work shares the machine.
  *
  * --model PATH renders (and scores on the chair test views, or on the captures of
- * --transforms) a saved model instead of training one; --save PATH saves the last model trained; --dump DIR writes each held-out photo beside
- * its render (DIR/SCENE_NN.png).
+ * --transforms) a saved model instead of training one; --save PATH saves the last model
+ * trained; --dump DIR writes each held-out photo beside its render (DIR/SCENE_NN.png), what
+ * MobileNetV2 calls every photo and its render (DIR/SCENE_names.txt) and a sheet of the pairs
+ * it names differently (DIR/SCENE_names.png).
  *
  * usage: bench_field [SCENE...] [--transforms PATH]... [--minutes 1,2,3,5]
  *                    [--set option=value]... [--model PATH] [--save PATH] [--dump DIR] */
@@ -365,7 +367,43 @@ typedef struct agreement {
  * centre crop 224); renders are made at that scale directly. Beside it, what the metric
  * allows: the same agreement for the photo against itself moved by one pixel (on the fox a
  * pose error of 0.2 degrees) and against itself slightly blurred. */
-static agreement top1_agreement(const vf_field *f, const view_set *views, const float bg[3])
+/* --dump: what the classifier called each photo and its render (DIR/NAME_names.txt), and the
+ * pairs it names differently side by side (DIR/NAME_names.png, the first 16), to see what
+ * the renders are taken for. probs: the photos' rows, then the renders'. */
+static void dump_names(const char *name, const vf_image *images, const float *probs, int n)
+{
+    enum { PAIRS = 16 };
+    char path[4096], captions[2 * PAIRS][96];
+    vf_image tiles[2 * PAIRS];
+    const char *caption_of[2 * PAIRS];
+    snprintf(path, sizeof path, "%s/%s_names.txt", dump_dir, name);
+    FILE *fp = fopen(path, "w");
+    if (!fp)
+        die(path);
+    int pairs = 0;
+    for (int i = 0; i < n; i++) {
+        int cls[2];
+        float p[2];
+        for (int k = 0; k < 2; k++)
+            vf_topk(probs + ((size_t)k * n + i) * VF_NUM_CLASSES, 1, &cls[k], &p[k]);
+        fprintf(fp, "%2d %s photo %s %.2f | render %s %.2f\n", i, cls[0] == cls[1] ? "same" : "DIFF",
+                vf_class_name(cls[0]), p[0], vf_class_name(cls[1]), p[1]);
+        for (int k = 0; cls[0] != cls[1] && pairs < PAIRS && k < 2; k++) {
+            snprintf(captions[2 * pairs + k], sizeof captions[0], "%s %d: %.40s\n%.2f",
+                     k ? "render" : "photo", i, vf_class_name(cls[k]), p[k]);
+            caption_of[2 * pairs + k] = captions[2 * pairs + k];
+            tiles[2 * pairs + k] = images[(size_t)k * n + i];
+        }
+        pairs += cls[0] != cls[1] && pairs < PAIRS;
+    }
+    fclose(fp);
+    snprintf(path, sizeof path, "%s/%s_names.png", dump_dir, name);
+    if (pairs && vf_contact_sheet(path, tiles, caption_of, NULL, 2 * pairs, 8) != VF_OK)
+        die(path);
+}
+
+static agreement top1_agreement(const char *name, const vf_field *f, const view_set *views,
+                                const float bg[3])
 {
     vf_classifier *cls;
     char path[4096];
@@ -395,6 +433,8 @@ static agreement top1_agreement(const vf_field *f, const view_set *views, const 
     }
     if (vf_classifier_classify_images(cls, images, KINDS * n, probs) != VF_OK)
         die("classifying");
+    if (dump_dir)
+        dump_names(name, images, probs, n);
     double *agree[KINDS] = {NULL, &a.render, &a.shift, &a.blur};
     for (int i = 0; i < n; i++) {
         int photo_class, render_class;
@@ -607,7 +647,7 @@ int main(int argc, char **argv)
             evaluate(name, f, &held, white, &r);
             print_run(name, r.train_seconds / 60, &r, !strcmp(name, "fox") ? 25 : 0);
             load_views(captures[c], 0, &all, NULL);
-            const agreement a = top1_agreement(f, &all, white);
+            const agreement a = top1_agreement(name, f, &all, white);
             printf("%-6s MobileNetV2 names the render like its photo: %.0f%% of %d photos "
                    "(target 80%%); the photo moved by 1 pixel: %.0f%%, blurred to %.1f dB: "
                    "%.0f%%; of the %d photos it names with p >= %.1f: %.0f%%\n",
