@@ -362,11 +362,6 @@ typedef struct agreement {
  * photos' top-1 is parachute, ski or sunglass at 0.1-0.4). */
 #define CONFIDENT 0.5
 
-/* Natural accuracy as the attack sees it: MobileNetV2's top-1 on each photo and on the
- * field's render at that photo's pose, after the same preprocessing (shorter side to 256,
- * centre crop 224); renders are made at that scale directly. Beside it, what the metric
- * allows: the same agreement for the photo against itself moved by one pixel (on the fox a
- * pose error of 0.2 degrees) and against itself slightly blurred. */
 /* --dump: what the classifier called each photo and its render (DIR/NAME_names.txt), and the
  * pairs it names differently side by side (DIR/NAME_names.png, the first 16), to see what
  * the renders are taken for. probs: the photos' rows, then the renders'. */
@@ -380,28 +375,33 @@ static void dump_names(const char *name, const vf_image *images, const float *pr
     FILE *fp = fopen(path, "w");
     if (!fp)
         die(path);
-    int pairs = 0;
+    int tile = 0;
     for (int i = 0; i < n; i++) {
         int cls[2];
         float p[2];
         for (int k = 0; k < 2; k++)
             vf_topk(probs + ((size_t)k * n + i) * VF_NUM_CLASSES, 1, &cls[k], &p[k]);
-        fprintf(fp, "%2d %s photo %s %.2f | render %s %.2f\n", i, cls[0] == cls[1] ? "same" : "DIFF",
+        const int differ = cls[0] != cls[1];
+        fprintf(fp, "%2d %s photo %s %.2f | render %s %.2f\n", i, differ ? "DIFF" : "same",
                 vf_class_name(cls[0]), p[0], vf_class_name(cls[1]), p[1]);
-        for (int k = 0; cls[0] != cls[1] && pairs < PAIRS && k < 2; k++) {
-            snprintf(captions[2 * pairs + k], sizeof captions[0], "%s %d: %.40s\n%.2f",
+        for (int k = 0; differ && tile < 2 * PAIRS && k < 2; k++, tile++) {
+            snprintf(captions[tile], sizeof captions[tile], "%s %d: %.40s\n%.2f",
                      k ? "render" : "photo", i, vf_class_name(cls[k]), p[k]);
-            caption_of[2 * pairs + k] = captions[2 * pairs + k];
-            tiles[2 * pairs + k] = images[(size_t)k * n + i];
+            caption_of[tile] = captions[tile];
+            tiles[tile] = images[(size_t)k * n + i];
         }
-        pairs += cls[0] != cls[1] && pairs < PAIRS;
     }
     fclose(fp);
     snprintf(path, sizeof path, "%s/%s_names.png", dump_dir, name);
-    if (pairs && vf_contact_sheet(path, tiles, caption_of, NULL, 2 * pairs, 8) != VF_OK)
+    if (tile && vf_contact_sheet(path, tiles, caption_of, NULL, tile, 8) != VF_OK)
         die(path);
 }
 
+/* Natural accuracy as the attack sees it: MobileNetV2's top-1 on each photo and on the
+ * field's render at that photo's pose, after the same preprocessing (shorter side to 256,
+ * centre crop 224); renders are made at that scale directly. Beside it, what the metric
+ * allows: the same agreement for the photo against itself moved by one pixel (on the fox a
+ * pose error of 0.2 degrees) and against itself slightly blurred. */
 static agreement top1_agreement(const char *name, const vf_field *f, const view_set *views,
                                 const float bg[3])
 {
