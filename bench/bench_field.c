@@ -391,7 +391,8 @@ static void dump_names(const char *name, const vf_image *images, const float *pr
             tiles[tile] = images[(size_t)k * n + i];
         }
     }
-    fclose(fp);
+    if (fclose(fp) != 0) /* a full disk shows here */
+        die(path);
     snprintf(path, sizeof path, "%s/%s_names.png", dump_dir, name);
     if (tile && vf_contact_sheet(path, tiles, caption_of, NULL, tile, 8) != VF_OK)
         die(path);
