@@ -4,9 +4,9 @@
  * as a user's photo folder would. Asserts: every photo is kept (none is blurry), the matcher
  * is exhaustive (a photo folder has no order), all 50 register in one model, and after a
  * similarity alignment the rotations agree with the dataset's reference poses to under 1 deg
- * (median), as the ordered fox test does. First, a weak matcher on the same photos
- * (sequential, 3 neighbours) must be refused and leave nothing behind.
- * About 4 minutes on 2 cores (COLMAP twice). */
+ * (median), as the ordered fox test does. First, a weak matcher on half of the photos
+ * (sequential, 2 neighbours) must be refused and leave nothing behind.
+ * About 3 minutes on 2 cores (COLMAP twice). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -85,9 +85,9 @@ static void unturn(const double c2w[16], double out[16])
     }
 }
 
-static const photo *find_photo(const photo *photos, const char *image_path)
+static const photo *find_photo(const photo *photos, int count, const char *image_path)
 {
-    for (int i = 0; i < PHOTOS; i++) {
+    for (int i = 0; i < count; i++) {
         char stem[64];
         snprintf(stem, sizeof stem, "%.16s", photos[i].hashed);
         if (strstr(image_path, stem))
@@ -107,7 +107,7 @@ static const vf_frame *find_reference(const vf_dataset *ref, const char *origina
 }
 
 /* Our poses in ws beside the dataset's, photo by photo (turned ones turned back). */
-static int pair_with_reference(const char *ws, const photo *photos, vf_dataset *ours,
+static int pair_with_reference(const char *ws, const photo *photos, int count, vf_dataset *ours,
                                vf_dataset *ref, double (*fixed)[16], const double **mine,
                                const double **theirs)
 {
@@ -117,8 +117,8 @@ static int pair_with_reference(const char *ws, const photo *photos, vf_dataset *
     CHECK(vf_dataset_load(vf_test_shared(FOX "/transforms.json"), ref) == VF_OK, "reference: %s",
           vf_error_message());
     int n = 0;
-    for (int i = 0; i < ours->count && n < PHOTOS; i++) {
-        const photo *p = find_photo(photos, ours->frames[i].image_path);
+    for (int i = 0; i < ours->count && n < count; i++) {
+        const photo *p = find_photo(photos, count, ours->frames[i].image_path);
         const vf_frame *r = p ? find_reference(ref, p->original) : NULL;
         if (!r)
             continue;
@@ -134,27 +134,29 @@ static int pair_with_reference(const char *ws, const photo *photos, vf_dataset *
 
 /* The fox photos in an order that says nothing about where they were taken (one random
  * shuffle, kept fixed so that the run below is the one measured). */
-static const int weak_order[PHOTOS] = {3,  31, 21, 29,  103, 12, 6,  72, 49, 35,  94, 54,  9,
-                                       33, 18, 90, 105, 108, 89, 2,  14, 39, 110, 84, 107, 77,
-                                       78, 42, 19, 34,  45,  74, 22, 44, 52, 7,   27, 30,  115,
-                                       76, 26, 46, 73,  81,  97, 4,  8,  85, 25,  1};
+static const int weak_order[] = {3,  31, 21, 29, 103, 12,  6,  72, 49, 35, 94, 54, 9,
+                                 33, 18, 90, 105, 108, 89, 2, 14, 39, 110, 84, 107};
+enum { WEAK_PHOTOS = sizeof weak_order / sizeof weak_order[0] };
 
-/* A weak matcher on photos in no order (sequential, 3 neighbours): the scene falls apart
- * (measured twice: 23 of 50 registered, two models). The stage must refuse it (too few
- * frames, or the registration check for a wrong model) and leave no poses behind; a model
- * it keeps must be right. With 4 neighbours COLMAP returns a right model or a wrong one that
- * registers every photo, from run to run; the check refused the wrong one once (9.8 deg) but
- * a CI run kept one (3.5 deg off the dataset, verdict not recorded) while a rerun agreed with
- * a right one (0.21 deg): that variant is left out until the check catches it every time. */
+/* A weak matcher on photos in no order (sequential, 2 neighbours, the first 25 of the
+ * shuffle): the scene falls apart (measured twice: 10 of 25 registered, 38 s). The stage must
+ * refuse it (too few frames, or the registration check for a wrong model) and leave no poses
+ * behind; a model it keeps must be right. All 50 photos with 3 neighbours were refused when
+ * this test was written (23 of 50 registered) but registered a right model in the two latest
+ * runs (0.72 deg), 58 s spent without reaching the refusal. With 4 neighbours COLMAP returns
+ * a right model or a wrong one that registers every photo, from run to run; the check refused
+ * the wrong one once (9.8 deg) but a CI run kept one (3.5 deg off the dataset) while a rerun
+ * agreed with a right one (0.21 deg): that variant is left out until the check catches it
+ * every time. */
 static void weak_matcher(const char *out, const char *err)
 {
     char dir[VF_PATH_MAX], ws[VF_PATH_MAX];
-    photo photos[PHOTOS] = {0};
+    photo photos[WEAK_PHOTOS] = {0};
     snprintf(dir, sizeof dir, "%s/weak_photos", vf_test_tmpdir());
     snprintf(ws, sizeof ws, "%s/weak_ws", vf_test_tmpdir());
     vf_mkdirs(dir);
     int written = 0;
-    for (int i = 0; i < PHOTOS; i++) {
+    for (int i = 0; i < WEAK_PHOTOS; i++) {
         char src[VF_PATH_MAX], dst[VF_PATH_MAX];
         snprintf(photos[i].original, sizeof photos[i].original, "%04d.jpg", weak_order[i]);
         snprintf(photos[i].hashed, sizeof photos[i].hashed, "weak-%02d.jpg", i);
@@ -162,18 +164,18 @@ static void weak_matcher(const char *out, const char *err)
         vf_path_join(dst, sizeof dst, dir, photos[i].hashed);
         written += vf_copy_file(src, dst) == VF_OK;
     }
-    CHECK(written == PHOTOS, "the weak matcher's folder (%d photos)", written);
+    CHECK(written == WEAK_PHOTOS, "the weak matcher's folder (%d photos)", written);
     int rc =
         vf_test_system("'%s' ingest '%s' -o '%s' --quiet 2>'%s'", getenv("VF_TOOL"), dir, ws, err);
     CHECK(rc == 0, "ingest exit %d (stderr in %s)", rc, err);
     double seconds;
-    rc = run_poses(ws, "--json --max-features 1024 --matcher sequential --overlap 3", out, err,
+    rc = run_poses(ws, "--json --max-features 1024 --matcher sequential --overlap 2", out, err,
                    &seconds);
     char *stderr_text = NULL;
     size_t size;
     vf_read_file(err, &stderr_text, &size);
     const char *line = stderr_text ? strstr(stderr_text, "error:") : NULL;
-    printf("sequential matching, overlap 3: exit %d in %.1f s%s%.*s\n", rc, seconds,
+    printf("sequential matching, overlap 2: exit %d in %.1f s%s%.*s\n", rc, seconds,
            line ? ": " : "", line ? (int)strcspn(line, "\n") : 0, line ? line : "");
     if (rc != 0) {
         CHECK(line && (strstr(line, "disagrees with all-pairs matching") ||
@@ -186,7 +188,7 @@ static void weak_matcher(const char *out, const char *err)
         vf_dataset ours, ref;
         double(*fixed)[16] = malloc(sizeof *fixed * PHOTOS);
         const double *mine[PHOTOS], *theirs[PHOTOS];
-        int n = pair_with_reference(ws, photos, &ours, &ref, fixed, mine, theirs);
+        int n = pair_with_reference(ws, photos, WEAK_PHOTOS, &ours, &ref, fixed, mine, theirs);
         printf("the model it kept: ");
         check_poses(mine, theirs, n, (pose_limits){1.0, 2.0, 0.01, 0.03});
         free(fixed);
@@ -238,7 +240,7 @@ int main(void)
     vf_dataset ours, ref;
     double(*fixed)[16] = malloc(sizeof *fixed * PHOTOS);
     const double *mine[PHOTOS], *theirs[PHOTOS];
-    int n = pair_with_reference(ws, photos, &ours, &ref, fixed, mine, theirs);
+    int n = pair_with_reference(ws, photos, PHOTOS, &ours, &ref, fixed, mine, theirs);
     CHECK(n == PHOTOS, "every registered photo traced to its reference (%d)", n);
     /* the ordered fox test's limits for the median; p90 a little looser (a third turned) */
     check_poses(mine, theirs, n, (pose_limits){1.0, 2.0, 0.01, 0.03});
