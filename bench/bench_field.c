@@ -23,8 +23,14 @@
  * MobileNetV2 calls every photo and its render (DIR/SCENE_names.txt) and a sheet of the pairs
  * it names differently (DIR/SCENE_names.png).
  *
+ * --holdout N scores a workspace's model on the photos its train stage held out (every Nth,
+ * as `train --holdout N`), not on every 8th; --cut (with --model, a field trained with
+ * `train --object-only`) cuts every photo by the field's silhouette first: object mode's
+ * held-out PSNR, naming and render time, the object on white against the photo cut alike.
+ *
  * usage: bench_field [SCENE...] [--transforms PATH]... [--minutes 1,2,3,5]
- *                    [--set option=value]... [--model PATH] [--save PATH] [--dump DIR] */
+ *                    [--set option=value]... [--model PATH] [--save PATH] [--dump DIR]
+ *                    [--holdout N] [--cut] */
 #define _GNU_SOURCE
 #include <math.h>
 #include <omp.h>
@@ -80,6 +86,27 @@ static void die(const char *what)
  * front or a './'); frames with index % holdout_every == 0 go to `held` (when holdout_every >
  * 0), the rest to `train`. A transforms file of a poses stage (points3D.txt and sparse/ beside
  * it) also gives each view its sparse points, for depth supervision. */
+/* Held-out frames: every 8th from the first for a model trained here; with --holdout N, a
+ * workspace's model is scored on the frames its train stage held out (frame % N == N / 2). */
+static int stage_holdout;
+
+static int is_held(int frame, int holdout_every)
+{
+    if (holdout_every <= 0)
+        return 0;
+    return stage_holdout ? frame % stage_holdout == stage_holdout / 2
+                         : frame % holdout_every == 0;
+}
+
+/* Object mode (--cut): every photo gets the model's silhouette as its alpha, so the scores
+ * and the classifier see the object on white, as `train --object-only` and `score` do. */
+static void cut_views(const vf_field *f, view_set *s)
+{
+    for (int i = 0; i < s->count; i++)
+        if (vf_field_cut_photo(f, &s->cameras[i], s->c2w + 16 * i, &s->images[i]) != VF_OK)
+            die("cutting a photo by the field's silhouette");
+}
+
 static void load_views(const char *name, int holdout_every, view_set *train, view_set *held)
 {
     char path[4096];
@@ -122,7 +149,7 @@ static void load_views(const char *name, int holdout_every, view_set *train, vie
     }
     int failed = 0;
     for (int i = 0; i < ds.count; i++) {
-        int to_held = holdout_every > 0 && i % holdout_every == 0;
+        int to_held = is_held(i, holdout_every);
         view_set *s = to_held ? held : train;
         if (!s)
             continue;
@@ -142,7 +169,7 @@ static void load_views(const char *name, int holdout_every, view_set *train, vie
     int *slot = malloc(sizeof(int) * (size_t)ds.count);
     view_set **owner = malloc(sizeof(view_set *) * (size_t)ds.count);
     for (int i = 0; i < ds.count; i++) {
-        int to_held = holdout_every > 0 && i % holdout_every == 0;
+        int to_held = is_held(i, holdout_every);
         owner[i] = to_held ? held : train;
         slot[i] = to_held ? hi++ : ti++;
     }
@@ -530,6 +557,7 @@ int main(int argc, char **argv)
     const char *captures[9];
     int capture_count = 0;
     const char *model_path = NULL, *save_path = NULL;
+    int cut = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--minutes") && i + 1 < argc) {
             minute_count = 0;
@@ -545,6 +573,10 @@ int main(int argc, char **argv)
             captures[capture_count++] = argv[++i];
         } else if (!strcmp(argv[i], "--dump") && i + 1 < argc) {
             dump_dir = argv[++i];
+        } else if (!strcmp(argv[i], "--holdout") && i + 1 < argc) {
+            stage_holdout = atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--cut")) {
+            cut = 1;
         } else if (!strcmp(argv[i], "--save") && i + 1 < argc) {
             save_path = argv[++i];
         } else if (!strcmp(argv[i], "--set") && i + 1 < argc) {
@@ -561,9 +593,13 @@ int main(int argc, char **argv)
             fprintf(stderr,
                     "usage: bench_field [chair] [lego] [fox] [render] [--transforms PATH]... "
                     "[--minutes 1,2,3,5] [--set option=value]... [--model PATH] "
-                    "[--save PATH] [--dump DIR]\n");
+                    "[--save PATH] [--dump DIR] [--holdout N] [--cut]\n");
             return 1;
         }
+    }
+    if (cut && !model_path) {
+        fprintf(stderr, "bench_field: --cut scores a model trained with --object-only (--model)\n");
+        return 1;
     }
     if (dump_dir && vf_mkdirs(dump_dir) != VF_OK) {
         fprintf(stderr, "bench_field: %s\n", vf_error_message());
@@ -645,9 +681,13 @@ int main(int argc, char **argv)
                 die(model_path);
             if (!model_path)
                 f = train(&opt, &train_views, &r);
+            if (cut)
+                cut_views(f, &held);
             evaluate(name, f, &held, white, &r);
             print_run(name, r.train_seconds / 60, &r, !strcmp(name, "fox") ? 25 : 0);
             load_views(captures[c], 0, &all, NULL);
+            if (cut)
+                cut_views(f, &all);
             const agreement a = top1_agreement(name, f, &all, white);
             printf("%-6s MobileNetV2 names the render like its photo: %.0f%% of %d photos "
                    "(target 80%%); the photo moved by 1 pixel: %.0f%%, blurred to %.1f dB: "

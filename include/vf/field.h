@@ -150,6 +150,12 @@ vf_status vf_field_cut_object(vf_field *f, const vf_field_cut_view *views, int n
 vf_status vf_field_silhouette(const vf_field *f, const vf_camera *cam, const double c2w[16],
                               int max_side, uint8_t **mask);
 
+/* Object mode: an RGB photo taken by cam from c2w becomes RGBA, its alpha the field's
+ * silhouette there (the object as a cut field holds it: what train's held-out scores and
+ * bench_field --cut compare renders with). VF_EINPUT when the photo is not cam's size. */
+vf_status vf_field_cut_photo(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                             vf_image *photo);
+
 /* ---- training ---------------------------------------------------------------------------- */
 
 /* What the field models beyond the object box the cameras look at. */

@@ -257,3 +257,26 @@ vf_status vf_field_silhouette(const vf_field *f, const vf_camera *cam, const dou
     vf_image_free(&opacity);
     return status;
 }
+
+vf_status vf_field_cut_photo(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                             vf_image *photo)
+{
+    if (photo->channels != 3 || photo->width != cam->width || photo->height != cam->height)
+        return vf_fail(VF_EINPUT, "a %dx%d photo is not the size of its %dx%d camera",
+                       photo->width, photo->height, cam->width, cam->height);
+    uint8_t *mask = NULL;
+    vf_image rgba = {0};
+    vf_status status = vf_field_silhouette(f, cam, c2w, 0, &mask);
+    if (status == VF_OK)
+        status = vf_image_alloc(&rgba, photo->width, photo->height, 4);
+    for (size_t p = 0; status == VF_OK && p < (size_t)photo->width * photo->height; p++) {
+        memcpy(rgba.data + 4 * p, photo->data + 3 * p, 3 * sizeof(float));
+        rgba.data[4 * p + 3] = mask[p];
+    }
+    free(mask);
+    if (status == VF_OK) {
+        vf_image_free(photo);
+        *photo = rgba;
+    }
+    return status;
+}

@@ -243,30 +243,6 @@ static vf_status sheet_tile(const vf_image *img, vf_image *out)
     return vf_image_resize(img, w > 0 ? w : 1, SHEET_HEIGHT, out);
 }
 
-/* Object mode: the photo with the field's silhouette as its alpha, the object's mask in a
- * held-out view. */
-static vf_status silhouette_cutout(const vf_field *f, const vf_frame *frame, vf_image *photo)
-{
-    if (photo->channels != 3 || photo->width != frame->camera.width ||
-        photo->height != frame->camera.height)
-        return vf_fail(VF_EINPUT, "%s is not the size of its camera", frame->image_path);
-    uint8_t *mask = NULL;
-    vf_image rgba = {0};
-    vf_status status = vf_field_silhouette(f, &frame->camera, frame->c2w, 0, &mask);
-    if (status == VF_OK)
-        status = vf_image_alloc(&rgba, photo->width, photo->height, 4);
-    for (size_t p = 0; status == VF_OK && p < (size_t)photo->width * photo->height; p++) {
-        memcpy(rgba.data + 4 * p, photo->data + 3 * p, 3 * sizeof(float));
-        rgba.data[4 * p + 3] = mask[p];
-    }
-    free(mask);
-    if (status == VF_OK) {
-        vf_image_free(photo);
-        *photo = rgba;
-    }
-    return status;
-}
-
 /* PSNR and SSIM of the held-out views; adds a per-view list to report, and writes sheet_path:
  * the first few held-out photos beside their renders. In object mode (object_cut) a photo is
  * cut out by the field's silhouette, and *mean_psnr_object is the PSNR inside it. */
@@ -290,7 +266,7 @@ static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int 
         vf_image raw = {0}, photo = {0}, render = {0}; /* raw: a cut-out's alpha is its mask */
         status = vf_image_load(views->frames[i].image_path, &raw);
         if (status == VF_OK && object_cut)
-            status = silhouette_cutout(f, &views->frames[i], &raw);
+            status = vf_field_cut_photo(f, &views->frames[i].camera, views->frames[i].c2w, &raw);
         if (status == VF_OK)
             status = vf_image_to_rgb(&raw, bg, &photo);
         if (status == VF_OK)
