@@ -1,4 +1,5 @@
-/* Rendering whole images from a field: one ray per pixel, rows spread over the cores. */
+/* Rendering whole images from a field: one ray per pixel, bands of blocks spread over the
+ * cores. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -65,23 +66,29 @@ static vf_status check_poses(const double *c2w, int n)
 typedef enum render_output { RENDER_RGB, RENDER_OPACITY, RENDER_DEPTH } render_output;
 
 /* Render one image into out (as `what` says) with the field's render setup (made once for a
- * batch of images). Runs in the calling thread; `parallel` spreads rows over the cores. */
-static void render_rows(const vf_field *f, const field_render_setup *setup, const vf_camera *cam,
+ * batch of images). Runs in the calling thread; `parallel` spreads the image over the cores.
+ * Pixels are marched in blocks of BLOCK x BLOCK (vf__field_render_rays), a band of blocks a
+ * task: the rays of a block, and of the next block in the band, cross the same grid cells,
+ * which stay in the core's caches. 224x224 views of four real captures' fields 11-14%
+ * faster than runs of 64 pixels of a row with two rows a task (same pixels; one process
+ * alternating the two, 2 threads). */
+static void render_image(const vf_field *f, const field_render_setup *setup, const vf_camera *cam,
                         const double c2w[16], render_output what, float *out, int parallel)
 {
-    enum { RUN = 64 }; /* pixels of a row marched together (vf__field_render_rays) */
-    const int width = cam->width, height = cam->height;
-#pragma omp parallel for schedule(dynamic, 2) if (parallel)
-    for (int y = 0; y < height; y++) {
-        for (int x0 = 0; x0 < width; x0 += RUN) {
-            const int n = width - x0 < RUN ? width - x0 : RUN;
-            field_ray rays[RUN];
-            field_march_result res[RUN];
+    enum { BLOCK = 16 };
+    const int width = cam->width, height = cam->height, bands = (height + BLOCK - 1) / BLOCK;
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+    for (int band = 0; band < bands; band++) {
+        const int y0 = band * BLOCK, h = height - y0 < BLOCK ? height - y0 : BLOCK;
+        for (int x0 = 0; x0 < width; x0 += BLOCK) {
+            const int w = width - x0 < BLOCK ? width - x0 : BLOCK, n = w * h;
+            field_ray rays[BLOCK * BLOCK];
+            field_march_result res[BLOCK * BLOCK];
             for (int j = 0; j < n; j++)
-                vf__field_camera_ray(cam, c2w, x0 + j + 0.5, y + 0.5, &rays[j]);
+                vf__field_camera_ray(cam, c2w, x0 + j % w + 0.5, y0 + j / w + 0.5, &rays[j]);
             vf__field_render_rays(f, setup, rays, n, 0.5f, f->stop_transmittance, res);
             for (int j = 0; j < n; j++) {
-                const size_t i = (size_t)y * width + x0 + j;
+                const size_t i = (size_t)(y0 + j / w) * width + x0 + j % w;
                 const float opacity = 1.0f - res[j].trans;
                 if (what == RENDER_RGB)
                     memcpy(out + 3 * i, res[j].rgb, sizeof res[j].rgb);
@@ -97,10 +104,10 @@ static void render_rows(const vf_field *f, const field_render_setup *setup, cons
 void vf__field_render_depth(const vf_field *f, const field_render_setup *setup,
                             const vf_camera *cam, const double c2w[16], float *depth)
 {
-    render_rows(f, setup, cam, c2w, RENDER_DEPTH, depth, 1);
+    render_image(f, setup, cam, c2w, RENDER_DEPTH, depth, 1);
 }
 
-/* One image, its rows spread over the cores: colour (3 channels) or opacity (1). */
+/* One image, its bands spread over the cores: colour (3 channels) or opacity (1). */
 static vf_status render_one(const vf_field *f, const vf_camera *cam, const double c2w[16],
                             int opacity, vf_image *out)
 {
@@ -112,7 +119,7 @@ static vf_status render_one(const vf_field *f, const vf_camera *cam, const doubl
     if (status == VF_OK) {
         field_render_setup setup;
         vf__field_render_setup_init(f, &setup);
-        render_rows(f, &setup, cam, c2w, opacity ? RENDER_OPACITY : RENDER_RGB, out->data, 1);
+        render_image(f, &setup, cam, c2w, opacity ? RENDER_OPACITY : RENDER_RGB, out->data, 1);
     }
     return status;
 }
@@ -142,14 +149,14 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
     field_render_setup setup;
     vf__field_render_setup_init(f, &setup);
     /* Small images: one image per thread keeps each core on its own memory; otherwise split
-     * every image's rows. */
+     * every image's bands. */
     if ((size_t)cam->width * cam->height <= 512 * 512 && n > 1) {
 #pragma omp parallel for schedule(dynamic, 1)
         for (int i = 0; i < n; i++)
-            render_rows(f, &setup, cam, c2w + 16 * i, RENDER_RGB, out[i].data, 0);
+            render_image(f, &setup, cam, c2w + 16 * i, RENDER_RGB, out[i].data, 0);
     } else {
         for (int i = 0; i < n; i++)
-            render_rows(f, &setup, cam, c2w + 16 * i, RENDER_RGB, out[i].data, 1);
+            render_image(f, &setup, cam, c2w + 16 * i, RENDER_RGB, out[i].data, 1);
     }
     return VF_OK;
 }
