@@ -82,10 +82,6 @@ static void die(const char *what)
     exit(2);
 }
 
-/* Load a transforms file (a path under ../shared, or one of the user's own with a '/' in
- * front or a './'); frames with index % holdout_every == 0 go to `held` (when holdout_every >
- * 0), the rest to `train`. A transforms file of a poses stage (points3D.txt and sparse/ beside
- * it) also gives each view its sparse points, for depth supervision. */
 /* Held-out frames: every 8th from the first for a model trained here; with --holdout N, a
  * workspace's model is scored on the frames its train stage held out (frame % N == N / 2). */
 static int stage_holdout;
@@ -107,6 +103,10 @@ static void cut_views(const vf_field *f, view_set *s)
             die("cutting a photo by the field's silhouette");
 }
 
+/* Load a transforms file (a path under ../shared, or one of the user's own with a '/' in
+ * front or a './'); the frames is_held() picks go to `held` (when holdout_every > 0), the
+ * rest to `train`. A transforms file of a poses stage (points3D.txt and sparse/ beside
+ * it) also gives each view its sparse points, for depth supervision. */
 static void load_views(const char *name, int holdout_every, view_set *train, view_set *held)
 {
     char path[4096];
