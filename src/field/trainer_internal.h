@@ -8,7 +8,13 @@
 #include "vf/rng.h"
 
 /* Training rays come in square tiles of pixels: neighbouring rays meet the same grid points,
- * so a thread marching a tile finds them in its cache. */
+ * so a thread marching a tile finds them in its cache. Larger tiles give more steps, smaller
+ * ones more varied batches; at 3 minutes, 2x2 against 4x4 (two runs each where given): the
+ * fox (dataset poses) 1831, 1684 against 3137, 3051 steps, +0.32, +0.23 dB held-out; the shoes
+ * video -0.19, -0.27 dB; the wall clock -0.13; the apple +0.13; the chair (1 minute) -0.02; the
+ * lego -0.03; renders named like the photos: the fox 24, 12% against 18, 18%, the shoes 65,
+ * 61% against 56, 58%, the clock 50 against 55%, the apple 21 against 26%. No clear gain, so
+ * 4 stays. 8x8 gave the fox 4089 steps but 23.20 dB (-2), 1x1 619 steps, 25.33 dB. */
 #define TRAIN_TILE 4
 
 /* The opacity per step of a fresh grid's points at the coarsest level (DVGO's
