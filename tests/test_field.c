@@ -237,6 +237,47 @@ static vf_field *make_sparse_field(void)
     return f;
 }
 
+/* A ray the renderer ends early on an opaque ball is renormalized over the opacity it met:
+ * closer to the ray marched to the end than the same stop with the rest taken from the white
+ * background, and reported opaque. */
+static void test_render_stop_renormalizes(void)
+{
+    vf_field *f = make_sparse_field();
+    f->stop_transmittance = 0.05f;
+    f->camera = (vf_camera){.width = 96, .height = 96, .fx = 128, .fy = 128, .cx = 48, .cy = 48};
+    vf_viewpoint v = {.psi = 30, .theta = 10, .phi = 60};
+    double c2w[16];
+    vf_viewpoint_to_c2w(&v, c2w);
+    field_render_setup setup;
+    vf__field_render_setup_init(f, &setup);
+    double renorm_error = 0, white_error = 0;
+    int stopped = 0, opaque = 0;
+    for (int y = 0; y < f->camera.height; y++)
+        for (int x = 0; x < f->camera.width; x++) {
+            field_ray ray;
+            field_march_result full, white, render;
+            vf__field_camera_ray(&f->camera, c2w, x + 0.5, y + 0.5, &ray);
+            vf__field_march(f, &ray, 0.5f, 1e-6f, NULL, &full);
+            vf__field_march(f, &ray, 0.5f, f->stop_transmittance, NULL, &white);
+            if (white.trans >= f->stop_transmittance)
+                continue;
+            vf__field_render_rays(f, &setup, &ray, 1, 0.5f, f->stop_transmittance, &render);
+            stopped++;
+            opaque += render.trans == 0;
+            for (int k = 0; k < 3; k++) {
+                renorm_error += fabs(render.rgb[k] - full.rgb[k]);
+                white_error += fabs(white.rgb[k] - full.rgb[k]);
+            }
+        }
+    CHECK(stopped > 100, "%d rays end early", stopped);
+    CHECK(opaque == stopped, "%d of %d rays ended early are opaque", opaque, stopped);
+    CHECK(renorm_error < 0.5 * white_error, "mean error %g renormalized, %g with white",
+          renorm_error / (3 * stopped), white_error / (3 * stopped));
+    printf("rays ended at 95%%: mean error %.4f renormalized, %.4f with white (%d rays)\n",
+           renorm_error / (3 * stopped), white_error / (3 * stopped), stopped);
+    vf_field_free(f);
+}
+
 /* The samples in occupied cells that the training march records (min_trans 0: rays go through
  * both balls) for every pixel of a view: cell and position of each. Returns the floats written. */
 static int record_march(const vf_field *f, const double c2w[16], field_scratch *sc, float *out,
@@ -1046,5 +1087,6 @@ int main(int argc, char **argv)
     CHECK_CASE(test_checkpoint_resume);
     CHECK_CASE(test_color_models);
     CHECK_CASE(test_automatic_options);
+    CHECK_CASE(test_render_stop_renormalizes);
     return check_finish();
 }

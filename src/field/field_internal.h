@@ -324,7 +324,8 @@ static inline float field_render_alpha(const field_render_grid *r, float d)
 
 /* The forward march of vf__field_march without recording (same lattice of samples) for n rays,
  * for rendering: samples under FIELD_VISIBLE_ALPHA are skipped, rays are clipped to the
- * occupied cells, opacity comes from the setup's table (see render_march.c). */
+ * occupied cells, opacity comes from the setup's table, and a ray ended below min_trans is
+ * renormalized over the opacity it met and reported opaque (see render_march.c). */
 void vf__field_render_rays(const vf_field *f, const field_render_setup *setup,
                            const field_ray *rays, int n, float jitter, float min_trans,
                            field_march_result *out);

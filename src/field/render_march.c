@@ -220,13 +220,19 @@ static inline void cursor_step(ray_cursor *c, const vf_field *f, const field_ren
         c->alive = 0;
 }
 
-static void cursor_finish(const ray_cursor *c, const vf_field *f, field_march_result *out)
+/* A ray stopped below min_trans lies on a surface, and what is left of its light comes from
+ * behind it, not from the background: its colour and depth so far are renormalized over the
+ * opacity met (as if the rest came from the same surface) and it is reported opaque. */
+static void cursor_finish(const ray_cursor *c, const vf_field *f, float min_trans,
+                          field_march_result *out)
 {
     const render_state *s = &c->state;
+    const int stopped = s->trans < min_trans;
+    const float scale = stopped ? 1.0f / (1.0f - s->trans) : 1.0f;
     for (int k = 0; k < 3; k++)
-        out->rgb[k] = s->rgb[k] + s->trans * f->background[k];
-    out->trans = s->trans;
-    out->depth = s->depth;
+        out->rgb[k] = stopped ? s->rgb[k] * scale : s->rgb[k] + s->trans * f->background[k];
+    out->trans = stopped ? 0.0f : s->trans;
+    out->depth = s->depth * scale;
     out->count = s->count;
     out->overflow = 0;
 }
@@ -256,7 +262,7 @@ void vf__field_render_rays(const vf_field *f, const field_render_setup *setup,
         for (int j = 0; j < LANES; j++) {
             while (c[j].alive)
                 cursor_step(&c[j], f, setup, min_trans);
-            cursor_finish(&c[j], f, &out[first + j]);
+            cursor_finish(&c[j], f, min_trans, &out[first + j]);
         }
     }
     for (; first < n; first++) {
@@ -264,6 +270,6 @@ void vf__field_render_rays(const vf_field *f, const field_render_setup *setup,
         cursor_init(&c, f, setup, &rays[first], jitter);
         while (c.alive)
             cursor_step(&c, f, setup, min_trans);
-        cursor_finish(&c, f, &out[first]);
+        cursor_finish(&c, f, min_trans, &out[first]);
     }
 }
