@@ -6,6 +6,9 @@
 
 #include <stdlib.h>
 #include <string.h>
+#if defined(__F16C__)
+#include <immintrin.h>
+#endif
 
 #include "../src/field/fast_math.h"
 #include "../src/field/trainer_internal.h"
@@ -71,12 +74,60 @@ static void test_fast_math(void)
     CHECK(worst_sig < 1e-6, "fast_sigmoid4 error %g", worst_sig);
 }
 
+/* fast_math.h's half-precision conversions: every half goes to a float and back to itself;
+ * floats round to the nearest half, ties to even, overflow to infinity, as the F16C
+ * instructions do (checked against them where the build has them, on a million random floats
+ * and every float near a half's rounding boundary). */
+static void test_half_conversions(void)
+{
+    int wrong = 0;
+    for (uint32_t h = 0; h < 65536; h++) {
+        const float f = fast_half_to_float((uint16_t)h);
+        const uint16_t back = fast_float_to_half(f);
+        const int nan = (h & 0x7c00u) == 0x7c00u && (h & 0x3ffu);
+        wrong += nan ? !isnan(f) || !isnan(fast_half_to_float(back)) : back != h;
+    }
+    CHECK(wrong == 0, "%d halves do not come back from float", wrong);
+    const struct { float f; uint16_t h; } known[] = {
+        {1.0f, 0x3c00}, {-2.0f, 0xc000}, {65504.0f, 0x7bff}, {65519.99f, 0x7bff},
+        {65520.0f, 0x7c00}, {1e30f, 0x7c00}, {-INFINITY, 0xfc00}, {0x1p-24f, 0x0001},
+        {0x1p-25f, 0x0000} /* a tie: to even */, {0x3p-25f, 0x0002} /* a tie: to even */,
+        {0x1p-14f, 0x0400}, {1.0f + 0x1p-11f, 0x3c00} /* a tie */,
+        {1.0f + 0x3p-11f, 0x3c02} /* a tie */, {-0.0f, 0x8000}, {FIELD_EMPTY_DENSITY, 0xcf80}};
+    for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
+        CHECK(fast_float_to_half(known[i].f) == known[i].h, "%g gives half %04x, not %04x",
+              known[i].f, fast_float_to_half(known[i].f), known[i].h);
+#if defined(__F16C__)
+    vf_rng rng;
+    vf_rng_seed(&rng, 11);
+    int differ = 0;
+    for (int i = 0; i < 1000000 + 65536 * 3; i++) {
+        uint32_t bits;
+        if (i < 1000000)
+            bits = (uint32_t)vf_rng_next(&rng);
+        else { /* around the boundary between half j and j + 1: a float just under, on, over */
+            const uint32_t j = (uint32_t)(i - 1000000) / 3;
+            float lo = fast_half_to_float((uint16_t)j), hi = fast_half_to_float((uint16_t)(j + 1));
+            float mid = lo / 2 + hi / 2;
+            memcpy(&bits, &mid, sizeof bits);
+            bits += (uint32_t)(i % 3) - 1;
+        }
+        float f;
+        memcpy(&f, &bits, sizeof f);
+        const uint16_t mine = fast_float_to_half(f), theirs = _cvtss_sh(f, 0);
+        differ += isnan(f) ? (mine & 0x7e00u) != 0x7e00u : mine != theirs;
+        differ += fast_half_to_float(theirs) != _cvtsh_ss(theirs) && !isnan(_cvtsh_ss(theirs));
+    }
+    CHECK(differ == 0, "%d conversions differ from F16C's", differ);
+#endif
+}
+
 /* The renderer's opacity table against 1 - exp(-softplus(d + shift) * scale * step). */
 static void test_alpha_table(void)
 {
     vf_field *f = make_field();
     field_render_setup setup;
-    vf__field_render_setup_init(f, &setup);
+    CHECK(vf__field_render_setup_init(f, &setup) == VF_OK, "render setup");
     const field_render_grid *r = &setup.grids[0];
     double worst = 0;
     for (float d = r->visible_density; d < r->visible_density + 60; d += 0.00731f) {
@@ -202,6 +253,16 @@ static void test_render_matches_march(void)
         CHECK(max_diff(&img, &batch[i]) == 0, "batch render %d differs", i);
     for (int i = 0; i < 3; i++)
         vf_image_free(&batch[i]);
+    /* the renderer reads a half copy of the values: it follows them when they change */
+    field_grid *g = &f->grids[0];
+    for (size_t i = 0; i < g->points; i++)
+        g->values[i * FIELD_CH + FIELD_CH_DENSITY] = FIELD_EMPTY_DENSITY;
+    vf__field_values_changed(f);
+    CHECK(vf_field_render(f, &f->camera, c2w, &again) == VF_OK, "render emptied");
+    double seen = 0;
+    for (size_t i = 0; i < (size_t)3 * again.width * again.height; i++)
+        seen = fmax(seen, fabs(again.data[i] - f->background[i % 3]));
+    CHECK(seen == 0, "the emptied field still shows (%g from its background)", seen);
     vf_image_free(&img);
     vf_image_free(&again);
     vf_field_free(f);
@@ -250,7 +311,7 @@ static void test_render_stop_renormalizes(void)
     double c2w[16];
     vf_viewpoint_to_c2w(&v, c2w);
     field_render_setup setup;
-    vf__field_render_setup_init(f, &setup);
+    CHECK(vf__field_render_setup_init(f, &setup) == VF_OK, "render setup");
     double renorm_error = 0, white_error = 0;
     int stopped = 0, opaque = 0;
     for (int y = 0; y < f->camera.height; y++)
@@ -482,7 +543,7 @@ static void test_hostile_models(void)
     /* the renderer's opacity table takes any density, NaN included, without reading outside */
     f = make_field();
     field_render_setup setup;
-    vf__field_render_setup_init(f, &setup);
+    CHECK(vf__field_render_setup_init(f, &setup) == VF_OK, "render setup");
     const field_render_grid *r = &setup.grids[0];
     const float odd[5] = {NAN, INFINITY, -INFINITY, 3e38f, -3e38f};
     for (int i = 0; i < 5; i++) {
@@ -1069,6 +1130,7 @@ int main(int argc, char **argv)
 {
     check_args(argc, argv);
     CHECK_CASE(test_fast_math);
+    CHECK_CASE(test_half_conversions);
     CHECK_CASE(test_alpha_table);
     CHECK_CASE(test_empty_radius);
     test_gradients((field_ray_losses){0});

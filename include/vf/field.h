@@ -30,6 +30,10 @@
  * Threads: rendering and training use every core (OpenMP). A vf_field may be rendered from
  * several threads at once; a trainer is used by one thread.
  *
+ * The renderer reads a half-precision copy of the field's grids (half as much memory again),
+ * made by the first render of a field and by the first render after training changed it:
+ * a few hundred milliseconds for a capture's field, once.
+ *
  * Memory: create/load functions allocate the object; the caller frees it with the matching
  * free function. Images passed in are borrowed (copied where kept); images filled by a
  * render function belong to the caller. */
@@ -90,7 +94,7 @@ typedef struct vf_field_info {
     int has_background_grid; /* 1 when a coarse outer grid models the surroundings */
     size_t points;           /* grid points in all grids */
     size_t occupied_cells;   /* cells that may hold visible density */
-    size_t bytes;            /* memory the field holds */
+    size_t bytes;            /* memory the field holds, its render copy included */
 } vf_field_info;
 
 void vf_field_get_info(const vf_field *f, vf_field_info *info);

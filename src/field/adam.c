@@ -153,6 +153,7 @@ static inline void adam_update(float *p, float *m, float *v, const float *grad,
 void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
                          float tv_color, float tv_view)
 {
+    vf__field_values_changed(f);
     adam->t++;
     const float bc1 = 1.0f - powf(adam->beta1, (float)adam->t);
     const float bc2 = 1.0f - powf(adam->beta2, (float)adam->t);

@@ -354,6 +354,7 @@ vf_status vf__trainer_build_grid(vf_field_trainer *t)
 
     if (t->has_alpha && (status = carve_grid(t, &f->grids[0], near_depth)) != VF_OK)
         return status;
+    vf__field_values_changed(f);
 
     if (outer) {
         /* a coarse outer grid for what lies around the object box: without it an opaque

@@ -6,7 +6,8 @@
  *   - grid points on a regular lattice over an axis-aligned box, FIELD_CH floats per point:
  *     channel 0 is the raw density d, channels 1..12 the degree-1 spherical-harmonics colour
  *     logits (colour k, basis b at 1 + 4k + b with basis (1, x, y, z) of the unit view
- *     direction), channels 13..15 are padding so that one point is one 64-byte cache line;
+ *     direction), channels 13..15 are padding so that one point is one 64-byte cache line
+ *     (the renderer reads a copy in half precision, 32 bytes a point: render_march.c);
  *   - values between points are trilinear; density sigma = softplus(d + shift) * scale per
  *     world unit; colour = sigmoid(SH logits . basis(direction));
  *   - a ray is sampled every `step` world units; sample i gets alpha_i = 1 - exp(-sigma_i step)
@@ -47,6 +48,8 @@ typedef struct field_grid {
     float voxel;       /* spacing between points, the same on every axis */
     size_t points;     /* dim[0] * dim[1] * dim[2] */
     float *values;     /* points * FIELD_CH floats, 64-byte aligned */
+    uint16_t *half;    /* the renderer's copy of values in IEEE half precision (NULL until the
+                          first render): see vf__field_render_setup_init */
     int cells[3];      /* dim - 1: the trilinear cells */
     uint64_t *cell_bits; /* one bit per cell: 1 when the cell may hold visible density */
     uint8_t *empty_radius; /* per cell: Chebyshev distance, in cells, to the nearest occupied
@@ -69,7 +72,15 @@ struct vf_field {
     vf_camera camera;      /* a reference training camera (intrinsics) */
     double scene_center[3]; /* the point the cameras look at */
     double camera_distance; /* their mean distance to it */
+    int half_stale;         /* values changed since the grids' half copies were made */
 };
+
+/* Whatever writes grid values in place calls this: the next render remakes the renderer's
+ * half-precision copies (a grid allocated anew has none, and gets them on its first render). */
+static inline void vf__field_values_changed(vf_field *f)
+{
+    f->half_stale = 1;
+}
 
 /* ---- grid.c: storage, trilinear resampling, occupancy -------------------------------- */
 
@@ -149,11 +160,13 @@ static inline float field_lattice_skip(const field_lattice *l, float k, const fl
 #define FIELD_ALWAYS_INLINE inline __attribute__((always_inline))
 
 /* Ask the caches for what sample k of lattice l in grid g will read: its cell's empty-space
- * radius and the 8 corner points (a cache line each, in four places far apart in memory).
- * The marchers wait on these loads, not on arithmetic; asked for one sample ahead, they
- * arrive while the current sample is worked on (measured in render_march.c and train.c). */
-static FIELD_ALWAYS_INLINE void field_prefetch_sample(const field_grid *g, const field_lattice *l,
-                                                      float k)
+ * radius and the 8 corner points (in four places far apart in memory) of `values`, an array of
+ * point_bytes a point laid out as the grid's values. The marchers wait on these loads, not on
+ * arithmetic; asked for one sample ahead, they arrive while the current sample is worked on
+ * (measured in render_march.c and train.c). */
+static FIELD_ALWAYS_INLINE void field_prefetch_points(const field_grid *g, const field_lattice *l,
+                                                      float k, const void *values,
+                                                      size_t point_bytes)
 {
     size_t cell = 0, point = 0, cell_stride = 1, point_stride = 1;
     for (int a = 0; a < 3; a++) {
@@ -164,17 +177,24 @@ static FIELD_ALWAYS_INLINE void field_prefetch_sample(const field_grid *g, const
         cell_stride *= (size_t)g->cells[a];
         point_stride *= (size_t)g->dim[a];
     }
-    const float *v = g->values + point * FIELD_CH;
-    const size_t oy = (size_t)g->dim[0] * FIELD_CH, oz = oy * (size_t)g->dim[1];
+    const char *v = (const char *)values + point * point_bytes;
+    const size_t ox = point_bytes, oy = (size_t)g->dim[0] * ox, oz = oy * (size_t)g->dim[1];
     __builtin_prefetch(g->empty_radius + cell);
     __builtin_prefetch(v);
-    __builtin_prefetch(v + FIELD_CH);
+    __builtin_prefetch(v + ox);
     __builtin_prefetch(v + oy);
-    __builtin_prefetch(v + oy + FIELD_CH);
+    __builtin_prefetch(v + oy + ox);
     __builtin_prefetch(v + oz);
-    __builtin_prefetch(v + oz + FIELD_CH);
+    __builtin_prefetch(v + oz + ox);
     __builtin_prefetch(v + oz + oy);
-    __builtin_prefetch(v + oz + oy + FIELD_CH);
+    __builtin_prefetch(v + oz + oy + ox);
+}
+
+/* The same for the float values (the training march). */
+static FIELD_ALWAYS_INLINE void field_prefetch_sample(const field_grid *g, const field_lattice *l,
+                                                      float k)
+{
+    field_prefetch_points(g, l, k, g->values, FIELD_CH * sizeof(float));
 }
 
 /* The raw density d at which a step of step_world reaches opacity `alpha`: alpha >= threshold
@@ -294,13 +314,17 @@ typedef struct field_render_grid {
     float alpha[FIELD_ALPHA_TABLE + 1]; /* alpha at visible_density + i / alpha_per_density */
     float occ_lo[3], occ_hi[3]; /* world box of the occupied cells */
     int empty;                  /* no occupied cell */
+    const uint16_t *half;       /* the grid's values in half precision */
 } field_render_grid;
 
 typedef struct field_render_setup {
     field_render_grid grids[FIELD_MAX_GRIDS];
 } field_render_setup;
 
-void vf__field_render_setup_init(const vf_field *f, field_render_setup *setup);
+/* The constants of a render of f, and the half-precision copies of its grids the renderer
+ * reads, made here when missing or stale (vf__field_values_changed). Fails only when out of
+ * memory. Call it outside parallel regions, before the rays. */
+vf_status vf__field_render_setup_init(const vf_field *f, field_render_setup *setup);
 
 /* The distance to the surface each pixel of the view sees (camera width x height floats):
  * the opacity-weighted mean distance of its samples where the opacity is over a half, else

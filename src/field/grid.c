@@ -55,6 +55,7 @@ vf_status vf__field_grid_alloc(field_grid *g, const int dim[3], const float lo[3
 void vf__field_grid_free(field_grid *g)
 {
     free(g->values);
+    free(g->half);
     free(g->cell_bits);
     free(g->empty_radius);
     memset(g, 0, sizeof *g);

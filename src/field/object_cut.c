@@ -186,8 +186,7 @@ vf_status vf_field_cut_object(vf_field *f, const vf_field_cut_view *views, int n
     if (!cams)
         return vf_fail(VF_EINTERNAL, "out of memory");
     field_render_setup setup;
-    vf__field_render_setup_init(f, &setup);
-    vf_status status = VF_OK;
+    vf_status status = vf__field_render_setup_init(f, &setup);
     const int visibility = !plane;
     for (int i = 0; i < n && status == VF_OK; i++) {
         vf_c2w_gl_to_w2c_cv(views[i].c2w, cams[i].rot, cams[i].t);
@@ -220,6 +219,7 @@ vf_status vf_field_cut_object(vf_field *f, const vf_field_cut_view *views, int n
                         *d = FIELD_EMPTY_DENSITY;
                 }
     }
+    vf__field_values_changed(f);
     for (int i = 0; i < n; i++)
         free(cams[i].depth);
     free(cams);

@@ -116,11 +116,11 @@ static vf_status render_one(const vf_field *f, const vf_camera *cam, const doubl
         status = check_poses(c2w, 1);
     if (status == VF_OK)
         status = ensure_image(out, cam->width, cam->height, opacity ? 1 : 3);
-    if (status == VF_OK) {
-        field_render_setup setup;
-        vf__field_render_setup_init(f, &setup);
+    field_render_setup setup;
+    if (status == VF_OK)
+        status = vf__field_render_setup_init(f, &setup);
+    if (status == VF_OK)
         render_image(f, &setup, cam, c2w, opacity ? RENDER_OPACITY : RENDER_RGB, out->data, 1);
-    }
     return status;
 }
 
@@ -144,10 +144,11 @@ vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const d
         status = check_poses(c2w, n);
     for (int i = 0; status == VF_OK && i < n; i++)
         status = ensure_image(&out[i], cam->width, cam->height, 3);
+    field_render_setup setup;
+    if (status == VF_OK)
+        status = vf__field_render_setup_init(f, &setup);
     if (status != VF_OK)
         return status;
-    field_render_setup setup;
-    vf__field_render_setup_init(f, &setup);
     /* Small images: one image per thread keeps each core on its own memory; otherwise split
      * every image's bands. */
     if ((size_t)cam->width * cam->height <= 512 * 512 && n > 1) {
@@ -209,7 +210,8 @@ void vf_field_get_info(const vf_field *f, vf_field_info *info)
         size_t cells = (size_t)gi->cells[0] * gi->cells[1] * gi->cells[2];
         info->points += gi->points;
         info->occupied_cells += vf__field_grid_occupied_cells(gi);
-        info->bytes += gi->points * FIELD_CH * sizeof(float) + cells / 8 + cells;
+        info->bytes += gi->points * FIELD_CH * (sizeof(float) + sizeof(uint16_t)) + cells / 8 +
+                       cells;
     }
 }
 
