@@ -544,7 +544,7 @@ static void bench_render(const vf_field *f)
     printf("render 224x224 (random ViewFool viewpoints, %d threads): median %.1f ms, min %.1f, "
            "max %.1f  %s\n",
            omp_get_max_threads(), times[N / 2], times[0], times[N - 1],
-           times[N / 2] < 25 ? "(target met)" : "(BELOW TARGET)");
+           times[N / 2] < 25 ? "(target met: under 25 ms)" : "(TARGET MISSED: 25 ms)");
 }
 
 int main(int argc, char **argv)
@@ -696,7 +696,7 @@ int main(int argc, char **argv)
                    a.confident, CONFIDENT, 100 * a.render_confident);
             double ms = render_ms_at_photos(f, &all);
             printf("%-6s render 224x224 at the photos' poses: median %.1f ms  %s\n", name, ms,
-                   ms < 15 ? "(target met)" : "(BELOW TARGET: 15 ms)");
+                   ms < 15 ? "(target met: under 15 ms)" : "(TARGET MISSED: 15 ms)");
             view_set_free(&all);
             if (save_path && vf_field_save(f, save_path) != VF_OK)
                 die(save_path);

@@ -15,7 +15,7 @@
  *     views of four real captures' fields 9-17% faster (A/B in one process, 2 threads);
  *   - it reads a copy of the grids in half precision (IEEE binary16, 11 significant bits): a
  *     point is 32 bytes, so a cell's 8 corners take 4 to 8 cache lines, not 8, and twice the
- *     grid fits the caches. 224 views of four real captures' fields 5-10% sooner one at a
+ *     grid fits the caches. 224 views of four real captures' fields 4-10% sooner one at a
  *     time, 4-16% in batches (A/B in one process, 2 threads), 84-88 dB from the float render
  *     (worst view 75 dB, largest pixel difference 0.03); the same held-out PSNR and names;
  *   - samples under FIELD_VISIBLE_ALPHA are skipped by a raw-density threshold;
@@ -313,7 +313,8 @@ static void cursor_finish(const ray_cursor *c, const vf_field *f, float min_tran
     out->overflow = 0;
 }
 
-enum { LANES = 4 }; /* rays marched in turn: 2 were 12% faster than 1, 4 another 5%, 8 slower */
+enum { LANES = 4 }; /* rays marched in turn: 2 were 12% faster than 1, 4 another 5%, 8 slower
+                      (8 again with the half copy: -1 to +4%, nothing measurable) */
 
 void vf__field_render_rays(const vf_field *f, const field_render_setup *setup,
                            const field_ray *rays, int n, float jitter, float min_trans,
