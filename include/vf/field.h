@@ -31,8 +31,8 @@
  * several threads at once; a trainer is used by one thread.
  *
  * The renderer reads a half-precision copy of the field's grids (half as much memory again),
- * made by the first render of a field and by the first render after training changed it:
- * a few hundred milliseconds for a capture's field, once.
+ * made by the first render of a field and by the first render after training or the object
+ * cut changed it: a few hundred milliseconds for a capture's field, once.
  *
  * Memory: create/load functions allocate the object; the caller frees it with the matching
  * free function. Images passed in are borrowed (copied where kept); images filled by a
@@ -94,7 +94,7 @@ typedef struct vf_field_info {
     int has_background_grid; /* 1 when a coarse outer grid models the surroundings */
     size_t points;           /* grid points in all grids */
     size_t occupied_cells;   /* cells that may hold visible density */
-    size_t bytes;            /* memory the field holds, its render copy included */
+    size_t bytes;            /* memory the field holds (with its render copy, once made) */
 } vf_field_info;
 
 void vf_field_get_info(const vf_field *f, vf_field_info *info);

@@ -7,7 +7,8 @@
  *     channel 0 is the raw density d, channels 1..12 the degree-1 spherical-harmonics colour
  *     logits (colour k, basis b at 1 + 4k + b with basis (1, x, y, z) of the unit view
  *     direction), channels 13..15 are padding so that one point is one 64-byte cache line
- *     (the renderer reads a copy in half precision, 32 bytes a point: render_march.c);
+ *     (on CPUs that convert half precision, the renderer reads a copy in half precision, 32
+ *     bytes a point: render_march.c);
  *   - values between points are trilinear; density sigma = softplus(d + shift) * scale per
  *     world unit; colour = sigmoid(SH logits . basis(direction));
  *   - a ray is sampled every `step` world units; sample i gets alpha_i = 1 - exp(-sigma_i step)
@@ -49,7 +50,7 @@ typedef struct field_grid {
     size_t points;     /* dim[0] * dim[1] * dim[2] */
     float *values;     /* points * FIELD_CH floats, 64-byte aligned */
     uint16_t *half;    /* the renderer's copy of values in IEEE half precision (NULL until the
-                          first render): see vf__field_render_setup_init */
+                          first render; always without FIELD_RENDER_HALF) */
     int cells[3];      /* dim - 1: the trilinear cells */
     uint64_t *cell_bits; /* one bit per cell: 1 when the cell may hold visible density */
     uint8_t *empty_radius; /* per cell: Chebyshev distance, in cells, to the nearest occupied
@@ -303,6 +304,17 @@ int vf__field_ray_segments(const vf_field *f, const field_ray *ray, field_segmen
 
 /* ---- render_march.c: rays forward only, as fast as they go ------------------------------ */
 
+/* What the renderer reads of a grid: a copy of its values in half precision where the CPU
+ * converts halves to floats in one instruction (F16C, AVX-512: 4-10% faster renders), its
+ * float values elsewhere (converting in software made VF_PORTABLE renders 60-80% slower). */
+#if defined(__F16C__) || defined(__AVX512F__)
+#define FIELD_RENDER_HALF 1
+typedef uint16_t field_render_value;
+#else
+#define FIELD_RENDER_HALF 0
+typedef float field_render_value;
+#endif
+
 /* Opacity of a step as a function of raw density, tabulated (see vf__field_render_setup_init). */
 #define FIELD_ALPHA_TABLE 2048
 
@@ -314,16 +326,16 @@ typedef struct field_render_grid {
     float alpha[FIELD_ALPHA_TABLE + 1]; /* alpha at visible_density + i / alpha_per_density */
     float occ_lo[3], occ_hi[3]; /* world box of the occupied cells */
     int empty;                  /* no occupied cell */
-    const uint16_t *half;       /* the grid's values in half precision */
+    const field_render_value *values; /* the grid's values as the renderer reads them */
 } field_render_grid;
 
 typedef struct field_render_setup {
     field_render_grid grids[FIELD_MAX_GRIDS];
 } field_render_setup;
 
-/* The constants of a render of f, and the half-precision copies of its grids the renderer
- * reads, made here when missing or stale (vf__field_values_changed). Fails only when out of
- * memory. Call it outside parallel regions, before the rays. */
+/* The constants of a render of f, and (FIELD_RENDER_HALF) the half-precision copies of its
+ * grids, made here when missing or stale (vf__field_values_changed; under a lock, so several
+ * threads may set up renders of one field at once). Fails only when out of memory. */
 vf_status vf__field_render_setup_init(const vf_field *f, field_render_setup *setup);
 
 /* The distance to the surface each pixel of the view sees (camera width x height floats):

@@ -185,9 +185,9 @@ vf_status vf_field_cut_object(vf_field *f, const vf_field_cut_view *views, int n
     cut_camera *cams = calloc((size_t)n, sizeof *cams);
     if (!cams)
         return vf_fail(VF_EINTERNAL, "out of memory");
+    const int visibility = !plane; /* else the plane decides, not what the views see */
     field_render_setup setup;
-    vf_status status = vf__field_render_setup_init(f, &setup);
-    const int visibility = !plane;
+    vf_status status = visibility ? vf__field_render_setup_init(f, &setup) : VF_OK;
     for (int i = 0; i < n && status == VF_OK; i++) {
         vf_c2w_gl_to_w2c_cv(views[i].c2w, cams[i].rot, cams[i].t);
         if (visibility)

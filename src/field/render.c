@@ -210,8 +210,9 @@ void vf_field_get_info(const vf_field *f, vf_field_info *info)
         size_t cells = (size_t)gi->cells[0] * gi->cells[1] * gi->cells[2];
         info->points += gi->points;
         info->occupied_cells += vf__field_grid_occupied_cells(gi);
-        info->bytes += gi->points * FIELD_CH * (sizeof(float) + sizeof(uint16_t)) + cells / 8 +
-                       cells;
+        info->bytes += gi->points * FIELD_CH * sizeof(float) + cells / 8 + cells;
+        if (gi->half)
+            info->bytes += gi->points * FIELD_CH * sizeof(uint16_t);
     }
 }
 

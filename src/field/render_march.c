@@ -9,27 +9,29 @@
  *   - four rays are marched in turn: each ray's march is a chain of dependent steps (position,
  *     cell, radius load, jump), and four independent chains keep the core busy (the fox's
  *     3-minute field: 12 jumps and 9 samples a pixel of a 224 view);
- *   - a sample blends all 16 floats of its 8 corner points as 16-lane vectors (one cache line
- *     each), added as a tree, not as one long chain of dependent additions;
+ *   - a sample blends all 16 channels of its 8 corner points as 16-lane float vectors, added
+ *     as a tree, not as one long chain of dependent additions;
  *   - the next sample's radius and corner points are prefetched (field_prefetch_points): 224
  *     views of four real captures' fields 9-17% faster (A/B in one process, 2 threads);
- *   - it reads a copy of the grids in half precision (IEEE binary16, 11 significant bits): a
- *     point is 32 bytes, so a cell's 8 corners take 4 to 8 cache lines, not 8, and twice the
- *     grid fits the caches. 224 views of four real captures' fields 4-10% sooner one at a
- *     time, 4-16% in batches (A/B in one process, 2 threads), 84-88 dB from the float render
- *     (worst view 75 dB, largest pixel difference 0.03); the same held-out PSNR and names;
+ *   - with F16C or AVX-512 (FIELD_RENDER_HALF) it reads a copy of the grids in half
+ *     precision (IEEE binary16, 11 significant bits): a point is 32 bytes, so a cell's 8
+ *     corners take 4 to 8 cache lines, not 8, and twice the grid fits the caches. 224 views
+ *     of four real captures' fields 4-10% sooner one at a time, 4-16% in batches (A/B in one
+ *     process, 2 threads), 84-88 dB from the float render (worst view 75 dB, largest pixel
+ *     difference 0.03); the same held-out PSNR and names. Without the instructions
+ *     (VF_PORTABLE) converting in software made renders 60-80% slower: it reads the floats;
  *   - samples under FIELD_VISIBLE_ALPHA are skipped by a raw-density threshold;
  *   - opacity comes from a table of raw density, and the colour's three sigmoids are one
  *     four-lane vector operation (fast_math.h). */
 
 #include <string.h>
 
-#if defined(__AVX512F__) || defined(__F16C__)
-#include <immintrin.h>
-#endif
-
 #include "fast_math.h"
 #include "field_internal.h"
+
+#if FIELD_RENDER_HALF
+#include <immintrin.h>
+#endif
 
 /* alpha(d) = 1 - exp(-softplus(d + shift) * scale * step) on [visible_density, d_opaque],
  * where d_opaque makes alpha 1 in float: a table lookup with linear interpolation replaces an
@@ -50,42 +52,40 @@ static void tabulate_alpha(const vf_field *f, field_render_grid *r)
 /* One grid point: density, the 12 SH logits and padding (FIELD_CH floats). */
 typedef float point_floats __attribute__((vector_size(FIELD_CH * sizeof(float))));
 
-/* The point at p from its FIELD_CH halves: one instruction with AVX-512, two with F16C;
- * elsewhere (VF_PORTABLE builds) fast_math.h's conversions, slower but the same values. */
+#if FIELD_RENDER_HALF
+/* The point at p from its FIELD_CH halves: one instruction with AVX-512, two with F16C. */
 static inline point_floats load_point(const uint16_t *p)
 {
 #if defined(__AVX512F__)
     return (point_floats)_mm512_cvtph_ps(_mm256_loadu_si256((const __m256i *)p));
-#elif defined(__F16C__)
+#else
     const __m256 lo = _mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)p));
     const __m256 hi = _mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(p + 8)));
     point_floats v;
     memcpy(&v, &lo, sizeof lo);
     memcpy((char *)&v + sizeof lo, &hi, sizeof hi);
     return v;
-#else
-    point_floats v;
-    for (int i = 0; i < FIELD_CH; i++)
-        v[i] = fast_half_to_float(p[i]);
-    return v;
 #endif
 }
 
-/* The FIELD_CH floats at v as halves at h, rounded to nearest (beyond the halves' range:
- * infinity, which the march takes as it takes an infinite float). */
+/* The FIELD_CH floats at v as halves at h, rounded to nearest. Values beyond the halves'
+ * range (65504) are clamped to it: an infinity would make NaN of a trilinear blend where a
+ * float grid gives a number (model files hold values up to 1e8; trained ones stay far below). */
 static inline void store_point_half(const float *v, uint16_t *h)
 {
 #if defined(__AVX512F__)
-    const __m256i x = _mm512_cvtps_ph(_mm512_loadu_ps(v), _MM_FROUND_TO_NEAREST_INT);
-    memcpy(h, &x, sizeof x);
-#elif defined(__F16C__)
-    const __m128i lo = _mm256_cvtps_ph(_mm256_loadu_ps(v), _MM_FROUND_TO_NEAREST_INT);
-    const __m128i hi = _mm256_cvtps_ph(_mm256_loadu_ps(v + 8), _MM_FROUND_TO_NEAREST_INT);
+    const __m512 big = _mm512_set1_ps(65504.0f);
+    const __m512 x = _mm512_max_ps(_mm512_min_ps(_mm512_loadu_ps(v), big), -big);
+    const __m256i out = _mm512_cvtps_ph(x, _MM_FROUND_TO_NEAREST_INT);
+    memcpy(h, &out, sizeof out);
+#else
+    const __m256 big = _mm256_set1_ps(65504.0f), small = _mm256_set1_ps(-65504.0f);
+    const __m256 a = _mm256_max_ps(_mm256_min_ps(_mm256_loadu_ps(v), big), small);
+    const __m256 b = _mm256_max_ps(_mm256_min_ps(_mm256_loadu_ps(v + 8), big), small);
+    const __m128i lo = _mm256_cvtps_ph(a, _MM_FROUND_TO_NEAREST_INT);
+    const __m128i hi = _mm256_cvtps_ph(b, _MM_FROUND_TO_NEAREST_INT);
     memcpy(h, &lo, sizeof lo);
     memcpy(h + 8, &hi, sizeof hi);
-#else
-    for (int i = 0; i < FIELD_CH; i++)
-        h[i] = fast_float_to_half(v[i]);
 #endif
 }
 
@@ -118,13 +118,23 @@ static vf_status make_half_copies(const vf_field *cf)
     }
     return status;
 }
+#else
+static inline point_floats load_point(const float *p)
+{
+    point_floats v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+#endif
 
 vf_status vf__field_render_setup_init(const vf_field *f, field_render_setup *setup)
 {
     memset(setup, 0, sizeof *setup);
+#if FIELD_RENDER_HALF
     vf_status status = make_half_copies(f);
     if (status != VF_OK)
         return status;
+#endif
     for (int i = 0; i < f->grid_count; i++) {
         const field_grid *g = &f->grids[i];
         field_render_grid *r = &setup->grids[i];
@@ -138,7 +148,11 @@ vf_status vf__field_render_setup_init(const vf_field *f, field_render_setup *set
             r->occ_lo[a] = g->lo[a] + (float)g->occ_lo[a] * g->voxel;
             r->occ_hi[a] = g->lo[a] + (float)g->occ_hi[a] * g->voxel;
         }
-        r->half = g->half;
+#if FIELD_RENDER_HALF
+        r->values = g->half;
+#else
+        r->values = g->values;
+#endif
     }
     return VF_OK;
 }
@@ -153,7 +167,7 @@ typedef struct render_state {
 /* Every channel of a sample at once: the trilinear blend of its cell's 8 corner points
  * (offsets and weights), summed as a tree (a chain of eight dependent FMAs was the march's
  * longest latency). */
-static inline point_floats trilinear(const uint16_t *v, const size_t offset[8], const float w[8])
+static inline point_floats trilinear(const field_render_value *v, const size_t offset[8], const float w[8])
 {
     return ((w[0] * load_point(v + offset[0]) + w[1] * load_point(v + offset[1])) +
             (w[2] * load_point(v + offset[2]) + w[3] * load_point(v + offset[3]))) +
@@ -267,19 +281,19 @@ static inline void cursor_step(ray_cursor *c, const vf_field *f, const field_ren
         return;
     }
     c->k = k + 1.0f;
-    field_prefetch_points(g, lat, c->k, c->rg->half, FIELD_CH * sizeof *c->rg->half);
+    field_prefetch_points(g, lat, c->k, c->rg->values, FIELD_CH * sizeof *c->rg->values);
 
     const float fx = field_clamp01(ux - (float)cx), fy = field_clamp01(uy - (float)cy);
     const float fz = field_clamp01(uz - (float)cz);
     const size_t base = (size_t)cx + c->point_y * cy + c->point_z * cz;
-    const uint16_t *v = c->rg->half + base * FIELD_CH;
+    const field_render_value *v = c->rg->values + base * FIELD_CH;
     const float gx = 1 - fx, gy = 1 - fy, gz = 1 - fz;
     const float a00 = gx * gy, a10 = fx * gy, a01 = gx * fy, a11 = fx * fy;
     const float w[8] = {a00 * gz, a10 * gz, a01 * gz, a11 * gz,
                         a00 * fz, a10 * fz, a01 * fz, a11 * fz};
     const size_t o1 = FIELD_CH, oy = c->point_y * FIELD_CH, oz = c->point_z * FIELD_CH;
     const size_t corner[8] = {0, o1, oy, oy + o1, oz, oz + o1, oz + oy, oz + oy + o1};
-    /* all channels at once: a corner's 16 floats are one vector load */
+    /* all channels at once: a corner is one load (and conversion) of 16 values */
     const point_floats point = trilinear(v, corner, w);
     const float d = point[FIELD_CH_DENSITY];
     if (d < c->rg->visible_density)
