@@ -30,9 +30,10 @@
  * Threads: rendering and training use every core (OpenMP). A vf_field may be rendered from
  * several threads at once; a trainer is used by one thread.
  *
- * The renderer reads a half-precision copy of the field's grids (half as much memory again),
- * made by the first render of a field and by the first render after training or the object
- * cut changed it: a few hundred milliseconds for a capture's field, once.
+ * On CPUs with F16C or AVX-512 the renderer reads a half-precision copy of the field's grids
+ * (half as much memory again), made by the first render of a field and by the first render
+ * after training or the object cut changed it: a few hundred milliseconds for a capture's
+ * field, once. A VF_PORTABLE build reads the floats.
  *
  * Memory: create/load functions allocate the object; the caller frees it with the matching
  * free function. Images passed in are borrowed (copied where kept); images filled by a
