@@ -7,6 +7,7 @@
 #include "vf/dataset.h"
 #include "vf/log.h"
 #include "vf/metrics.h"
+#include "vf/poses.h"
 
 #define ERROR_GAIN 4.0f /* error images: |render - photo| x 4, so 0.25 off shows white */
 
@@ -14,7 +15,8 @@ static const char usage[] =
     "usage: vfcapture eval WS --transforms PATH/transforms_test.json [--out DIR] [--json]\n"
     "\n"
     "Render every frame of a posed test set (NeRF transforms format, in the workspace's object\n"
-    "frame) with the trained field of WS at the frame's own resolution and camera, and report\n"
+    "frame; a posed set's own test set is moved there when the poses stage moved the set)\n"
+    "with the trained field of WS at the frame's own resolution and camera, and report\n"
     "PSNR and SSIM per view and on average. Transparent test pixels are composited onto the\n"
     "field's background colour. With --out, the renders and error images are saved there.\n"
     "\n"
@@ -123,6 +125,11 @@ int cmd_eval(int argc, char **argv)
     vf_field *field = NULL;
     if (status == VF_OK)
         status = cli_open_trained(opt.workspace, &ws, &field);
+    int moved = 0;
+    if (status == VF_OK && (status = vf_poses_move_set_frames(&ws, &test, &moved)) == VF_OK &&
+        moved)
+        vf_info("%s: moved from the posed set's frame into the object frame of the poses stage",
+                opt.transforms);
     if (status != VF_OK) {
         vf_dataset_free(&test);
         return cli_fail("eval", status);

@@ -53,7 +53,7 @@ typedef struct vf_ingest_options {
 void vf_ingest_defaults(vf_ingest_options *options);
 
 /* What a workspace's frames came from, as its ingest report says: "video", "photos",
- * "camera", "transforms", or "" when the report does not say (frames put there by hand).
+ * "camera", or "" when there is no report (a posed set, a 3D model, frames put there by hand).
  * Frames of a video or a webcam are in capture order; photos and unknown frames are not. */
 void vf_ingest_source_kind(const char *ws_root, char *kind, size_t size);
 /* The file or folder the frames came from (absolute), or "" as above. */

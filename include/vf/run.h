@@ -6,8 +6,9 @@
  *     json_t *summary;
  *     vf_status s = vf_run("WS", &o, &summary);
  *
- * Calls each stage's library function in turn: ingest, poses (not for a posed import or a 3D
- * model), train, attack, real (a 3D model only: the attack's viewpoints on the object itself)
+ * Calls each stage's library function in turn: ingest, poses (not for a 3D model; for a posed
+ * set only when its photos have a background, and then it keeps the set's poses and only
+ * triangulates points), train, attack, real (a 3D model only: the attack's viewpoints on the object itself)
  * and export. WS/run.json remembers, per stage, the settings it ran with and the completion
  * stamp the manifest gave it; a stage is redone when its output is missing, its settings
  * changed, it was re-run by hand since, or a stage before it was redone (or `restart`). Each

@@ -109,6 +109,15 @@ static void choose_methods(poses_run *run, const char *source)
 {
     const vf_poses_options *opt = run->opt;
     int n = run->frames.count;
+    if (run->posed) {
+        run->matcher = strcmp(opt->matcher, "auto") ? opt->matcher : "poses";
+        run->camera_model = vf_camera_has_distortion(&opt->known) ? "OPENCV" : "PINHOLE";
+        vf_info("a posed set: its poses and camera (%s) are kept, COLMAP triangulates points",
+                run->camera_model);
+        if (strcmp(run->matcher, "poses"))
+            vf_info("matching with %s", run->matcher);
+        return;
+    }
     int ordered = !strcmp(source, "video") || !strcmp(source, "camera");
     run->matcher = strcmp(opt->matcher, "auto") ? opt->matcher : vf_poses_auto_matcher(n, ordered);
     const char *why = strcmp(opt->matcher, "auto") ? ""
@@ -355,10 +364,19 @@ static json_t *summarize(const poses_run *run, const vf_normalization *norm)
                           norm->up_method, "center_method", norm->center_method, "scale_to_object",
                           norm->object_from_world.scale, "seconds", run->seconds);
     json_object_set(j, "check", run->check ? run->check : json_null());
-    json_object_set_new(j, "mapping", json_string(run->relaxed ? "relaxed" : "default"));
+    json_object_set_new(j, "mapping", json_string(run->posed     ? "known poses"
+                                                  : run->relaxed ? "relaxed"
+                                                                 : "default"));
     if (run->fallback) /* the matcher first chosen, whose model was not trusted */
         json_object_set_new(j, "fallback_from", json_string(run->fallback));
     return j;
+}
+
+/* Was WS/ingest a posed set (`ingest --transforms`)? */
+static int posed_set(const vf_workspace *ws)
+{
+    const json_t *params = json_object_get(vf_workspace_stage_record(ws, "ingest"), "params");
+    return !strcmp(json_string_value(json_object_get(params, "source")) ?: "", "transforms");
 }
 
 /* Everything inside the staging folder; *summary on success. */
@@ -377,6 +395,8 @@ static vf_status run_stage(poses_run *run, const vf_workspace *ws, json_t **summ
         status = vf_mkdirs(run->scratch);
     if (status == VF_OK)
         status = vf_colmap_open(&run->colmap, log_path);
+    if (status == VF_OK && run->posed)
+        status = vf__poses_load_set(run, ws);
     if (status == VF_OK)
         status = prepare_frames(run, ws);
     if (status != VF_OK)
@@ -384,9 +404,14 @@ static vf_status run_stage(poses_run *run, const vf_workspace *ws, json_t **summ
     char source[32];
     vf_ingest_source_kind(ws->root, source, sizeof source);
     choose_methods(run, source);
-    if ((status = vf__poses_extract_features(run)) == VF_OK &&
-        (status = vf__poses_match(run)) == VF_OK && (status = vf__poses_map(run)) == VF_OK &&
-        (status = verify_model(run)) == VF_OK)
+    status = vf__poses_extract_features(run);
+    if (status == VF_OK)
+        status = !strcmp(run->matcher, "poses") ? vf__poses_match_posed(run) : vf__poses_match(run);
+    if (status == VF_OK && run->posed)
+        status = vf__poses_triangulate(run);
+    else if (status == VF_OK && (status = vf__poses_map(run)) == VF_OK)
+        status = verify_model(run);
+    if (status == VF_OK)
         status = export_outputs(run, &norm);
     if (status == VF_OK) {
         json_object_set_new(run->seconds, "total", json_real(vf_now() - run->stage.start_time));
@@ -408,7 +433,7 @@ vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **sum
                        "... -o %s' first",
                        ws->root, ws->root);
     vf_poses_options opt = *o; /* the known camera is fitted to the frames' size */
-    poses_run run = {.opt = &opt, .seconds = json_object()};
+    poses_run run = {.opt = &opt, .seconds = json_object(), .posed = posed_set(ws)};
     status = vf_stage_begin(ws, "poses", &run.stage);
     if (status == VF_OK)
         status = run_stage(&run, ws, summary);
@@ -430,7 +455,29 @@ vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **sum
     }
     vf_colmap_model_free(&run.model);
     vf_sfm_images_free(&run.frames);
+    vf_dataset_free(&run.set);
     json_decref(run.seconds);
     json_decref(run.check);
+    return status;
+}
+
+vf_status vf_poses_move_set_frames(const vf_workspace *ws, vf_dataset *ds, int *moved)
+{
+    *moved = 0;
+    const json_t *summary = json_object_get(vf_workspace_stage_record(ws, "poses"), "summary");
+    const char *mapping = json_string_value(json_object_get(summary, "mapping"));
+    if (!vf_workspace_has_stage(ws, "poses") || !mapping || strcmp(mapping, "known poses"))
+        return VF_OK;
+    char path[VF_PATH_MAX];
+    vf_similarity object_from_set;
+    vf_status status = vf_workspace_path(ws, "poses", VF_NORMALIZATION_FILE, path, sizeof path);
+    if (status == VF_OK)
+        status = vf_normalization_load(path, &object_from_set, NULL);
+    for (int i = 0; status == VF_OK && i < ds->count; i++) {
+        double c2w[16];
+        vf_similarity_apply_c2w(&object_from_set, ds->frames[i].c2w, c2w);
+        memcpy(ds->frames[i].c2w, c2w, sizeof c2w);
+    }
+    *moved = status == VF_OK;
     return status;
 }

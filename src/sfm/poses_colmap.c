@@ -12,7 +12,7 @@
 
 /* Run one COLMAP command and record its wall time under its name, or under "check" while
  * run->checking (summed over repeats). */
-static vf_status run_step(poses_run *run, const char *label, vf_args *args)
+vf_status vf__poses_run_step(poses_run *run, const char *label, vf_args *args)
 {
     double seconds = 0;
     vf_status status = vf_colmap_run(&run->colmap, label, (size_t)run->frames.count, args,
@@ -50,7 +50,7 @@ vf_status vf__poses_extract_features(poses_run *run)
     }
     vf_args_opt(&a, "--SiftExtraction.use_gpu", "0");
     vf_args_opt(&a, "--SiftExtraction.max_num_features", "%d", run->opt->max_features);
-    return run_step(run, "COLMAP: extracting features", &a);
+    return vf__poses_run_step(run, "COLMAP: extracting features", &a);
 }
 
 /* A vocabulary tree of the capture's own features (Debian's COLMAP ships none, and the
@@ -72,7 +72,7 @@ static vf_status build_vocab_tree(poses_run *run, char *path, size_t size)
     vf_args_opt(&a, "--vocab_tree_path", "%s", path);
     vf_args_opt(&a, "--num_visual_words", "%ld", words);
     vf_args_opt(&a, "--max_num_images", "%d", images);
-    return run_step(run, "COLMAP: building a vocabulary tree", &a);
+    return vf__poses_run_step(run, "COLMAP: building a vocabulary tree", &a);
 }
 
 vf_status vf__poses_match(poses_run *run)
@@ -109,10 +109,10 @@ vf_status vf__poses_match(poses_run *run)
     } else {
         vf_args_opt(&a, "--ExhaustiveMatching.block_size", "10"); /* finer progress */
     }
-    return run_step(run, sequential  ? "COLMAP: matching neighbours"
-                         : retrieval ? "COLMAP: matching similar frames"
-                                     : "COLMAP: matching all pairs",
-                    &a);
+    const char *label = sequential  ? "COLMAP: matching neighbours"
+                        : retrieval ? "COLMAP: matching similar frames"
+                                    : "COLMAP: matching all pairs";
+    return vf__poses_run_step(run, label, &a);
 }
 
 /* Map into `output`; only the images named in image_list when it is not NULL. `relaxed`
@@ -137,14 +137,13 @@ static vf_status run_mapper(poses_run *run, const char *output, const char *imag
         vf_args_opt(&a, "--Mapper.ba_refine_principal_point", "0");
         vf_args_opt(&a, "--Mapper.ba_refine_extra_params", "0");
     }
-    return run_step(run,
-                    image_list ? "COLMAP: checking (registering the sample)"
-                    : relaxed  ? "COLMAP: registering frames again, on fewer matches"
-                               : "COLMAP: registering frames",
-                    &a);
+    const char *label = image_list ? "COLMAP: checking (registering the sample)"
+                        : relaxed  ? "COLMAP: registering frames again, on fewer matches"
+                                   : "COLMAP: registering frames";
+    return vf__poses_run_step(run, label, &a);
 }
 
-static vf_status convert_to_text(poses_run *run, const char *input, const char *output)
+vf_status vf__poses_convert_to_text(poses_run *run, const char *input, const char *output)
 {
     vf_status status = vf_mkdirs(output);
     if (status != VF_OK)
@@ -154,7 +153,7 @@ static vf_status convert_to_text(poses_run *run, const char *input, const char *
     vf_args_opt(&a, "--input_path", "%s", input);
     vf_args_opt(&a, "--output_path", "%s", output);
     vf_args_opt(&a, "--output_type", "TXT");
-    return run_step(run, NULL, &a);
+    return vf__poses_run_step(run, NULL, &a);
 }
 
 static int is_number(const char *name)
@@ -188,7 +187,7 @@ static vf_status load_largest_model(poses_run *run, const char *sparse_dir, cons
         if (status == VF_OK)
             status = vf_path_join(txt, sizeof txt, text_root, entry->d_name);
         if (status == VF_OK)
-            status = convert_to_text(run, bin, txt);
+            status = vf__poses_convert_to_text(run, bin, txt);
         if (status == VF_OK)
             status = vf_colmap_model_load(txt, &model);
         if (status != VF_OK)
@@ -210,7 +209,7 @@ static vf_status load_largest_model(poses_run *run, const char *sparse_dir, cons
 
 /* Move the chosen model's text files to stage/sparse (replacing those of an earlier mapping
  * of this run: the check's fallback maps again). */
-static vf_status keep_model_text(poses_run *run, const char *text)
+vf_status vf__poses_keep_model_text(poses_run *run, const char *text)
 {
     char to[VF_PATH_MAX];
     vf_status status = vf_path_join(to, sizeof to, run->stage.dir, "sparse");
@@ -279,7 +278,7 @@ vf_status vf__poses_map(poses_run *run)
         }
     }
     if (status == VF_OK && run->model.image_count > 0)
-        status = keep_model_text(run, text);
+        status = vf__poses_keep_model_text(run, text);
     return status;
 }
 
@@ -380,7 +379,7 @@ static vf_status check_model(poses_run *run, poses_check *out)
     vf_args_opt(&a, "--match_list_path", "%s", pairs);
     vf_args_opt(&a, "--match_type", "pairs");
     vf_args_opt(&a, "--SiftMatching.use_gpu", "0");
-    status = run_step(run, "COLMAP: checking (all pairs of a sample)", &a);
+    status = vf__poses_run_step(run, "COLMAP: checking (all pairs of a sample)", &a);
     if (status == VF_OK) {
         status = run_mapper(run, sparse, list, 0);
         if (status != VF_OK && run->colmap.last_exit == 1)
@@ -489,9 +488,9 @@ vf_status vf__poses_undistort(poses_run *run, vf_colmap_model *out)
     vf_args_opt(&a, "--input_path", "%s", run->model_dir);
     vf_args_opt(&a, "--output_path", "%s", out_dir);
     vf_args_opt(&a, "--output_type", "COLMAP");
-    status = run_step(run, "COLMAP: undistorting", &a);
+    status = vf__poses_run_step(run, "COLMAP: undistorting", &a);
     if (status == VF_OK)
-        status = convert_to_text(run, sparse, txt);
+        status = vf__poses_convert_to_text(run, sparse, txt);
     if (status == VF_OK)
         status = vf_colmap_model_load(txt, out);
     drop_stereo_files(out_dir);

@@ -8,6 +8,7 @@
 #include "vf/camera.h"
 #include "vf/colmap.h"
 #include "vf/colmap_model.h"
+#include "vf/dataset.h"
 #include "vf/pose.h"
 #include "vf/poses.h"
 #include "vf/sfm_images.h"
@@ -46,9 +47,17 @@ typedef struct poses_run {
     int checking;               /* the registration check's steps are timed as "check" */
     json_t *check;              /* its result for the summary, or NULL (not run) */
     const char *fallback;       /* the automatic matcher given up for all pairs, or NULL */
+    int posed;                  /* WS/ingest is a posed set: its poses are kept */
+    vf_dataset set;             /* that set (WS/ingest/transforms.json), when posed */
 } poses_run;
 
 /* COLMAP steps (poses_colmap.c); each adds its wall time to run->seconds. */
+/* Run one COLMAP command (args->items[0]), timed under its name; frees args. */
+vf_status vf__poses_run_step(poses_run *run, const char *label, vf_args *args);
+/* COLMAP's binary model in `input` as text files in `output` (created). */
+vf_status vf__poses_convert_to_text(poses_run *run, const char *input, const char *output);
+/* Move the kept model's text files to stage/sparse. */
+vf_status vf__poses_keep_model_text(poses_run *run, const char *text);
 vf_status vf__poses_extract_features(poses_run *run);
 vf_status vf__poses_match(poses_run *run);
 /* Map, convert every model COLMAP made to text, keep the largest in run->model and its text
@@ -68,5 +77,16 @@ typedef struct poses_check {
 vf_status vf__poses_check(poses_run *run, poses_check *out);
 /* Undistorted pinhole images in stage/undistorted/images and their cameras in `out`. */
 vf_status vf__poses_undistort(poses_run *run, vf_colmap_model *out);
+
+
+/* A posed set (poses_known.c): its poses and camera kept, COLMAP only triangulates points. */
+/* Load WS/ingest/transforms.json into run->set; its one camera becomes the known intrinsics
+ * (VF_EINPUT when frames differ in camera, or the user gave intrinsics too). */
+vf_status vf__poses_load_set(poses_run *run, const vf_workspace *ws);
+/* Match each frame with the frames nearest in viewing direction, by the set's poses. */
+vf_status vf__poses_match_posed(poses_run *run);
+/* Triangulate at the set's poses into run->model (kept in stage/sparse); VF_EINPUT when no
+ * point could be triangulated. */
+vf_status vf__poses_triangulate(poses_run *run);
 
 #endif
