@@ -9,8 +9,9 @@
 static const char usage[] =
     "usage: vfcapture run VIDEO|PHOTO_FOLDER|TRANSFORMS_JSON|MODEL.glb -o WS [options]\n"
     "\n"
-    "Run the whole pipeline on one capture: ingest, poses (COLMAP; skipped for a posed\n"
-    "transforms.json or a 3D model), train, attack, real (a 3D model only: the attack's\n"
+    "Run the whole pipeline on one capture: ingest, poses (COLMAP; skipped for a 3D model;\n"
+    "a posed transforms.json keeps its poses and gets sparse points triangulated, unless its\n"
+    "background is removed), train, attack, real (a 3D model only: the attack's\n"
     "viewpoints on the model itself) and export. Stages whose output is already in WS with the\n"
     "same settings are kept; the first missing or changed stage and every stage after it run.\n"
     "Ends with a summary and the paths of the shot card and the attack report. When a stage\n"
