@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The pipeline end to end on a small budget: `run` on the chair (import, train, attack,
-# export), a second `run` that finds every stage up to date, `render` and `eval` of the
-# trained field, a benchmark set built and scored by every shared model, transfer and benchmark
-# eval with CNNs and a (small, random-weight) transformer in one run, and bad input to those
-# commands failing with one line while the workspace stays as it was.
+# The pipeline end to end on a small budget: `run` on the chair (import; poses skipped, its
+# background is removed; train, attack, export), a second `run` that finds every stage up to
+# date, `render` and `eval` of the trained field, a benchmark set built and scored by every
+# shared model, transfer and benchmark eval with CNNs and a (small, random-weight)
+# transformer in one run, and bad input to those commands failing with one line while the
+# workspace stays as it was.
 source "$(dirname "$0")/shell_checks.sh"
 
 chair="$shared/data/nerf_synthetic/chair"
@@ -28,6 +29,8 @@ python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); assert m["stages"][
 
 expect 0 "run again" -- "$tool" run "$chair/transforms_train.json" -o "$ws" "${budget[@]}"
 [ "$(grep -c "is up to date" "$tmp/err")" -eq 4 ] && ok || bad "every stage up to date on the second run: $(cat "$tmp/err")"
+grep -q "poses is skipped: a posed set without a background" "$tmp/err" && ok \
+  || bad "the chair (background removed) skips the poses stage: $(grep poses "$tmp/err")"
 
 expect 0 "render a viewpoint" -- "$tool" render "$ws" --viewpoint 30,0,60,0,0,0 --size 128 -o "$tmp/view.png"
 [ -s "$tmp/view.png" ] && ok || bad "render wrote the image"

@@ -4,7 +4,8 @@
  * through the workspace API, as ingest would leave it. run_poses() runs `vfcapture poses` (the
  * tool from $VF_TOOL) with stdout and stderr in files and returns its exit code and wall time.
  * load_json() reads a JSON document. compare_poses() measures how far poses are from reference
- * poses after a similarity alignment of the camera centres. */
+ * poses after a similarity alignment of the camera centres; find_by_file_name() pairs our frames
+ * with a reference set's by file name. */
 #ifndef VF_TEST_POSES_HELPERS_H
 #define VF_TEST_POSES_HELPERS_H
 
@@ -14,6 +15,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "vf/dataset.h"
 #include "vf/log.h"
 #include "vf/pose.h"
 #include "vf/workspace.h"
@@ -81,6 +83,22 @@ static inline double quantile(double *v, int n, double q)
     qsort(v, (size_t)n, sizeof *v, compare_double);
     int i = (int)(q * (n - 1) + 0.5);
     return v[i];
+}
+
+/* The frame of `set` whose image file name ends ours ("0001.jpg" in "0003_0001.jpg", as
+ * `ingest --transforms` names it), or NULL. */
+static inline const vf_frame *find_by_file_name(const vf_dataset *set, const char *path)
+{
+    char name[256], other[256];
+    vf_path_basename(name, sizeof name, path, 0);
+    size_t len = strlen(name);
+    for (int i = 0; i < set->count; i++) {
+        vf_path_basename(other, sizeof other, set->frames[i].image_path, 0);
+        size_t olen = strlen(other);
+        if (olen <= len && !strcmp(name + len - olen, other))
+            return &set->frames[i];
+    }
+    return NULL;
 }
 
 /* vf_pose_compare against the object frame's camera distance (NaNs when it cannot align). */

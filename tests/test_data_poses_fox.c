@@ -21,29 +21,13 @@ static void position(const double c2w[16], double p[3])
     vf_mat4_translation(c2w, p);
 }
 
-/* The reference frame whose image file name ends ours ("0001.jpg", or "0000_0001.jpg" as
- * `ingest --transforms` names it), or NULL. */
-static const vf_frame *find_reference(const vf_dataset *ref, const char *path)
-{
-    char name[256], other[256];
-    vf_path_basename(name, sizeof name, path, 0);
-    size_t len = strlen(name);
-    for (int i = 0; i < ref->count; i++) {
-        vf_path_basename(other, sizeof other, ref->frames[i].image_path, 0);
-        size_t olen = strlen(other);
-        if (olen <= len && !strcmp(name + len - olen, other))
-            return &ref->frames[i];
-    }
-    return NULL;
-}
-
 /* Compare with the reference after a similarity alignment of the camera centres. */
 static void compare_with_reference(const vf_dataset *ours, const vf_dataset *ref)
 {
     int n = ours->count, matched = 0;
     const double **mine = malloc(sizeof *mine * n), **theirs = malloc(sizeof *theirs * n);
     for (int i = 0; i < n; i++) {
-        const vf_frame *match = find_reference(ref, ours->frames[i].image_path);
+        const vf_frame *match = find_by_file_name(ref, ours->frames[i].image_path);
         if (match) {
             mine[matched] = ours->frames[i].c2w;
             theirs[matched++] = match->c2w;

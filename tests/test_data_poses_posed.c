@@ -39,21 +39,6 @@ static void write_subset(const char *path)
     json_decref(doc);
 }
 
-/* The set's frame whose file name ends ours ("0001.jpg" in "0003_0001.jpg"), or NULL. */
-static const vf_frame *find_frame(const vf_dataset *set, const char *path)
-{
-    char name[256], other[256];
-    vf_path_basename(name, sizeof name, path, 0);
-    size_t len = strlen(name);
-    for (int i = 0; i < set->count; i++) {
-        vf_path_basename(other, sizeof other, set->frames[i].image_path, 0);
-        size_t olen = strlen(other);
-        if (olen <= len && !strcmp(name + len - olen, other))
-            return &set->frames[i];
-    }
-    return NULL;
-}
-
 /* The file holds one line, and it says `what`. */
 static int one_line_saying(const char *path, const char *what)
 {
@@ -122,7 +107,7 @@ int main(void)
                   **theirs = malloc(sizeof *theirs * FRAMES);
     int matched = 0;
     for (int i = 0; i < ours.count && matched < FRAMES; i++) {
-        const vf_frame *f = find_frame(&set, ours.frames[i].image_path);
+        const vf_frame *f = find_by_file_name(&set, ours.frames[i].image_path);
         if (f) {
             mine[matched] = ours.frames[i].c2w;
             theirs[matched++] = f->c2w;
@@ -141,7 +126,7 @@ int main(void)
     vf_workspace_close(&w);
     double worst = 0;
     for (int i = 0; i < ours.count; i++) {
-        const vf_frame *f = find_frame(&set, ours.frames[i].image_path);
+        const vf_frame *f = find_by_file_name(&set, ours.frames[i].image_path);
         for (int k = 0; f && k < 16; k++)
             worst = fmax(worst, fabs(f->c2w[k] - ours.frames[i].c2w[k]));
     }
