@@ -1,5 +1,6 @@
 /* vfcapture poses: parse the options, run the poses stage (vf/poses.h), print the summary. */
 #include <stdio.h>
+#include <string.h>
 
 #include "cli.h"
 #include "vf/calib.h"
@@ -140,7 +141,10 @@ static vf_status parse_options(int argc, char **argv, const char **workspace,
 
 static void print_summary(const json_t *s, const char *workspace)
 {
-    printf("registered %lld of %lld frames, mean reprojection error %.2f px, %lld points\n",
+    const char *mapping = json_string_value(json_object_get(s, "mapping"));
+    int known = mapping && !strcmp(mapping, "known poses");
+    printf("%s %lld of %lld frames, mean reprojection error %.2f px, %lld points\n",
+           known ? "kept the set's poses of" : "registered",
            json_integer_value(json_object_get(s, "registered")),
            json_integer_value(json_object_get(s, "total")),
            json_number_value(json_object_get(s, "reprojection_error_px")),
