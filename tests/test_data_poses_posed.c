@@ -5,7 +5,8 @@
  * frame), COLMAP's lens is the set's, the points reproject within a pixel and every photo
  * sees 100 or more of them, all in front of it (what training's depth loss reads); the set's
  * own frames moved as eval moves a set's test set land on the stage's. A set that
- * brings its camera refuses another one (--intrinsics) in one line. */
+ * brings its camera refuses another one (--intrinsics), and poses in OpenCV's axes are found
+ * not to fit the photos, each in one line. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,21 +18,27 @@
 #include "vf/poses.h"
 
 #define FOX "data/real_captures/instant_ngp_fox"
-#define EVERY 3
 #define FRAMES 17 /* of 50 */
 
-/* The fox's transforms.json with every EVERY-th frame, image paths made absolute. */
-static void write_subset(const char *path)
+/* The fox's transforms.json with every `every`-th frame, image paths made absolute; `flip`
+ * turns the poses into OpenCV's camera axes (a common mistake: y down, looking along +z). */
+static void write_subset(const char *path, int every, int flip)
 {
     json_t *doc = load_json(vf_test_shared(FOX "/transforms.json"));
     CHECK(doc != NULL, "the fox's transforms.json loads");
     json_t *frames = json_object_get(doc, "frames"), *kept = json_array();
-    for (size_t i = 0; i < json_array_size(frames); i += EVERY) {
+    for (size_t i = 0; i < json_array_size(frames); i += (size_t)every) {
         json_t *f = json_deep_copy(json_array_get(frames, i));
         char file[VF_PATH_MAX];
         snprintf(file, sizeof file, "%s/%s", vf_test_shared(FOX),
                  json_string_value(json_object_get(f, "file_path")));
         json_object_set_new(f, "file_path", json_string(file));
+        json_t *m = json_object_get(f, "transform_matrix");
+        for (size_t r = 0; flip && r < 3; r++)
+            for (size_t c = 1; c < 3; c++) {
+                json_t *row = json_array_get(m, r);
+                json_array_set_new(row, c, json_real(-json_number_value(json_array_get(row, c))));
+            }
         json_array_append_new(kept, f);
     }
     json_object_set_new(doc, "frames", kept);
@@ -62,7 +69,7 @@ int main(void)
     vf_path_join(ws, sizeof ws, dir, "fox");
     vf_path_join(out, sizeof out, dir, "out.json");
     vf_path_join(err, sizeof err, dir, "err.txt");
-    write_subset(set_path);
+    write_subset(set_path, 3, 0);
     const char *tool = getenv("VF_TOOL") ? getenv("VF_TOOL") : "vfcapture";
     int rc = vf_test_system("'%s' ingest --transforms '%s' -o '%s' >/dev/null 2>'%s'", tool,
                             set_path, ws, err);
@@ -72,6 +79,19 @@ int main(void)
     rc = run_poses(ws, "--intrinsics 700,700,270,480", out, err, NULL);
     CHECK(rc != 0 && one_line_saying(err, "brings its own camera"),
           "--intrinsics on a posed set: one error line (exit %d)", rc);
+
+    /* poses in OpenCV's axes do not fit the photos: one line saying so (measured: the points
+     * take in 0% of the matches, right poses 19-29%) */
+    char flipped[VF_PATH_MAX], flipped_ws[VF_PATH_MAX];
+    vf_path_join(flipped, sizeof flipped, dir, "flipped.json");
+    vf_path_join(flipped_ws, sizeof flipped_ws, dir, "flipped");
+    write_subset(flipped, 6, 1);
+    rc = vf_test_system("'%s' ingest --transforms '%s' -o '%s' >/dev/null 2>'%s'", tool, flipped,
+                        flipped_ws, err);
+    CHECK(rc == 0, "ingest --transforms of the flipped set exit %d", rc);
+    rc = run_poses(flipped_ws, "-q", out, err, NULL);
+    CHECK(rc != 0 && one_line_saying(err, "poses do not fit its photos"),
+          "poses in the wrong axes: one error line (exit %d)", rc);
 
     double seconds;
     rc = run_poses(ws, "--json", out, err, &seconds);
@@ -91,6 +111,9 @@ int main(void)
     /* measured: 2,455 points at 0.61 px (all 50 photos: 9,670 at 0.70 px) */
     CHECK(points > 1000, "%d points triangulated", points);
     CHECK(error < 1.0, "reprojection error %.3f px", error);
+    double explained = json_number_value(json_object_get(summary, "matches_explained"));
+    printf("the points take in %.0f%% of the matched features\n", 100 * explained);
+    CHECK(explained > 0.15, "the set's poses explain %.2f of the matches", explained);
     const json_t *cam = json_array_get(json_object_get(summary, "cameras"), 0);
     CHECK(!strcmp(json_string_value(json_object_get(cam, "model")) ?: "", "OPENCV") &&
               fabs(json_number_value(json_array_get(json_object_get(cam, "params"), 0)) -

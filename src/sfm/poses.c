@@ -367,6 +367,8 @@ static json_t *summarize(const poses_run *run, const vf_normalization *norm)
     json_object_set_new(j, "mapping", json_string(run->posed     ? "known poses"
                                                   : run->relaxed ? "relaxed"
                                                                  : "default"));
+    if (run->posed) /* how well the set's poses fit its photos (poses_known.c) */
+        json_object_set_new(j, "matches_explained", json_real(run->explained));
     if (run->fallback) /* the matcher first chosen, whose model was not trusted */
         json_object_set_new(j, "fallback_from", json_string(run->fallback));
     return j;

@@ -49,6 +49,7 @@ typedef struct poses_run {
     const char *fallback;       /* the automatic matcher given up for all pairs, or NULL */
     int posed;                  /* WS/ingest is a posed set: its poses are kept */
     vf_dataset set;             /* that set (WS/ingest/transforms.json), when posed */
+    double explained;           /* posed: the share of matched features its points take in */
 } poses_run;
 
 /* COLMAP steps (poses_colmap.c); each adds its wall time to run->seconds. */
@@ -86,7 +87,8 @@ vf_status vf__poses_load_set(poses_run *run, const vf_workspace *ws);
 /* Match each frame with the frames nearest in viewing direction, by the set's poses. */
 vf_status vf__poses_match_posed(poses_run *run);
 /* Triangulate at the set's poses into run->model (kept in stage/sparse); VF_EINPUT when no
- * point could be triangulated. */
+ * point could be triangulated, or the points take in too few of the matched features (poses
+ * that do not fit the photos). */
 vf_status vf__poses_triangulate(poses_run *run);
 
 #endif

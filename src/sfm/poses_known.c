@@ -201,6 +201,48 @@ static vf_status write_known_model(poses_run *run, const char *dir)
     return status;
 }
 
+/* The feature matches between frames that COLMAP verified (two-view geometry inliers). */
+static vf_status verified_matches(const char *database, long long *count)
+{
+    sqlite3 *db = NULL;
+    sqlite3_stmt *stmt = NULL;
+    *count = 0;
+    int ok = sqlite3_open_v2(database, &db, SQLITE_OPEN_READONLY, NULL) == SQLITE_OK &&
+             sqlite3_prepare_v2(db, "SELECT SUM(rows) FROM two_view_geometries WHERE rows > 0",
+                                -1, &stmt, NULL) == SQLITE_OK &&
+             sqlite3_step(stmt) == SQLITE_ROW;
+    if (ok)
+        *count = sqlite3_column_int64(stmt, 0);
+    vf_status status = ok ? VF_OK
+                          : vf_fail(VF_EINTERNAL, "cannot read %s: %s", database,
+                                    db ? sqlite3_errmsg(db) : "cannot open");
+    sqlite3_finalize(stmt);
+    sqlite3_close(db);
+    return status;
+}
+
+/* Do the set's poses fit its photos? Points triangulated at right poses take in a good share
+ * of the feature matches between frames; at wrong ones (another photo's pose, another axis
+ * convention) few survive. The share: observations of points over the matches' ends. Measured:
+ * the fox 0.19 (50 frames, 20 neighbours each) and 0.29 (13 frames), the NeRF-synthetic chair
+ * 0.20; the 13 fox frames with their poses shuffled 0.03 (291 points, 1.25 px). */
+#define POSED_MIN_EXPLAINED 0.10
+static vf_status check_explained(poses_run *run)
+{
+    long long matches, observations = 0;
+    vf_status status = verified_matches(run->database, &matches);
+    for (int i = 0; i < run->model.point_count; i++)
+        observations += run->model.points[i].track_length;
+    run->explained = matches > 0 ? (double)observations / (2.0 * (double)matches) : 0;
+    if (status != VF_OK || matches == 0 || run->explained >= POSED_MIN_EXPLAINED)
+        return status; /* no match at all: too few features, said below */
+    return vf_fail(VF_EINPUT, "the set's poses do not fit its photos: points at those poses take "
+                              "in %.0f%% of the features matched between frames (right poses: "
+                              "19-29%%); check that its poses are camera-to-world in OpenGL axes "
+                              "(NeRF's convention) and belong to these images",
+                   100 * run->explained);
+}
+
 vf_status vf__poses_triangulate(poses_run *run)
 {
     char known[VF_PATH_MAX], sparse[VF_PATH_MAX], text[VF_PATH_MAX];
@@ -237,11 +279,15 @@ vf_status vf__poses_triangulate(poses_run *run)
         return status;
     snprintf(run->model_dir, sizeof run->model_dir, "%s", sparse);
     run->model_count = 1;
+    if ((status = check_explained(run)) != VF_OK)
+        return status;
     if (run->model.point_count == 0)
         return vf_fail(VF_EINPUT, "COLMAP triangulated no points at the set's poses: its photos "
-                                  "share too few features, or the poses are wrong (a posed "
-                                  "set trains without this stage)");
-    vf_info("%d points triangulated at the set's poses (reprojection error %.2f px)",
-            run->model.point_count, vf_colmap_model_reprojection_error(&run->model));
+                                  "share too few features (a posed set trains without this "
+                                  "stage)");
+    vf_info("%d points triangulated at the set's poses (reprojection error %.2f px; they take "
+            "in %.0f%% of the matched features)",
+            run->model.point_count, vf_colmap_model_reprojection_error(&run->model),
+            100 * run->explained);
     return vf__poses_keep_model_text(run, text);
 }
