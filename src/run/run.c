@@ -47,12 +47,13 @@ static vf_status call_stage(int which, vf_workspace *ws, const vf_run_options *o
 /* A posed set needs its points triangulated (the poses stage) only when its photos show the
  * surroundings: the depth loss places them (the fox, 3 minutes: 25.2 -> 27.4 dB held-out).
  * A set with the background removed (NeRF-synthetic) skips it: no gain was measured there,
- * and it would add COLMAP's time to every run. */
+ * and it would add COLMAP's time to every run. A poses stage already in the workspace (of an
+ * earlier input) is redone instead, or training would read its stale frames. */
 static const char *skip_poses_of_set(const vf_workspace *ws)
 {
     const json_t *summary = json_object_get(vf_workspace_stage_record(ws, "ingest"), "summary");
     const char *background = json_string_value(json_object_get(summary, "background"));
-    return background && !strcmp(background, "transparent")
+    return background && !strcmp(background, "transparent") && !vf_workspace_has_stage(ws, "poses")
                ? "a posed set without a background needs no sparse points"
                : NULL;
 }
