@@ -246,6 +246,7 @@ static void apply_setting(vf_field_train_options *o, const char *text)
     else if (!strcmp(name, "depth")) o->depth = (float)v;
     else if (!strcmp(name, "step_ratio")) o->step_ratio = (float)v;
     else if (!strcmp(name, "prune_alpha")) o->prune_alpha = (float)v;
+    else if (!strcmp(name, "appearance")) o->appearance = (float)v;
     else if (!strcmp(name, "box_scale")) o->box_scale = (float)v;
     else if (!strcmp(name, "background_scale")) o->background_scale = (float)v;
     else if (!strcmp(name, "carve_share")) o->carve_share = (float)v;

@@ -14,7 +14,8 @@
  * from that checkpoint unless `restart` is set, and the checkpoint goes only once the stage is
  * committed. Output: WS/train/model.vff (VF_FIELD_FILE), report.json (mode "scene" or
  * "object", views, held_out_views, steps, seconds, surroundings, color, view_smoothing, field,
- * grid, bytes, depth_points [sightings of sparse points in the training photos handed to the
+ * grid, bytes, appearance [the per-photo appearance's learning rate, 0 when off],
+ * depth_points [sightings of sparse points in the training photos handed to the
  * depth loss, which drops any that fall outside their photo; 0 when it was off or had none],
  * held_out_psnr/ssim, held_out [per view]), held_out.jpg. */
 #ifndef VF_TRAIN_H
@@ -48,6 +49,10 @@ typedef struct vf_train_options {
                               Monte-Carlo noise, 0 for photos */
     double depth;          /* the field's depth-loss weight (vf/field.h) on the sparse points
                               of a poses stage; < 0: the trainer's default (-1); 0: off */
+    int appearance;        /* opaque photos: learn each photo's colour gain and offset with the
+                              field (vf/field.h appearance), so that its exposure and white
+                              balance are not drawn into the field; renders show the photos'
+                              mean. Off by default (measured there) */
     int restart;                        /* ignore a checkpoint of an interrupted run */
     /* Object mode (vf/cutout.h): cut the object out of every photo with the help of the
      * poses stage's sparse points; train on the whole photos as in scene mode; then the

@@ -4,6 +4,7 @@
  * and lists the points it touched. The update then visits only those points: each point is
  * updated once, by the lowest-numbered thread that touched it, which sums all the threads'
  * gradients for it. Points a batch did not touch keep their moments unchanged ("lazy" Adam). */
+#include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -220,4 +221,44 @@ void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH]
             }
         }
     }
+}
+
+/* ---- each photo's appearance: 6 floats a view, a dense Adam ---------------------------- */
+
+vf_status vf__trainer_alloc_appearance(vf_field_trainer *t)
+{
+    if (!(t->opt.appearance > 0) || t->has_alpha || t->appearance)
+        return VF_OK;
+    const size_t n = 6 * (size_t)t->view_count;
+    t->appearance = calloc(3 * n, sizeof *t->appearance);
+    t->appearance_grad = calloc(n * (size_t)t->threads, sizeof *t->appearance_grad);
+    if (!t->appearance || !t->appearance_grad)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    t->appearance_m = t->appearance + n;
+    t->appearance_v = t->appearance + 2 * n;
+    return VF_OK;
+}
+
+void vf__trainer_appearance_step(vf_field_trainer *t, float lr)
+{
+    const size_t n = 6 * (size_t)t->view_count;
+    const float beta1 = 0.9f, beta2 = 0.99f;
+    t->appearance_t++;
+    const float c1 = 1.0f - powf(beta1, (float)t->appearance_t);
+    const float c2 = 1.0f - powf(beta2, (float)t->appearance_t);
+    double mean[6] = {0};
+    for (size_t i = 0; i < n; i++) {
+        double g = 0;
+        for (int th = 0; th < t->threads; th++) {
+            g += t->appearance_grad[(size_t)th * n + i];
+            t->appearance_grad[(size_t)th * n + i] = 0;
+        }
+        float *m = &t->appearance_m[i], *v = &t->appearance_v[i];
+        *m = beta1 * *m + (1 - beta1) * (float)g;
+        *v = beta2 * *v + (1 - beta2) * (float)(g * g);
+        t->appearance[i] -= lr * (*m / c1) / (sqrtf(*v / c2) + 1e-8f);
+        mean[i % 6] += t->appearance[i];
+    }
+    for (size_t i = 0; i < n; i++)
+        t->appearance[i] -= (float)(mean[i % 6] / t->view_count);
 }

@@ -26,7 +26,8 @@
 #define MODEL_MAGIC "VFFIELD\n"
 #define MODEL_VERSION 1u
 #define CHECKPOINT_MAGIC "VFCKPT\n"
-#define CHECKPOINT_VERSION 3u /* 2: surroundings model replaced keep_background; 3: colour model */
+#define CHECKPOINT_VERSION 4u /* 2: surroundings model replaced keep_background; 3: colour
+                                 model; 4: the photos' appearance */
 
 /* ---- a file with a running checksum ------------------------------------------------------ */
 
@@ -382,7 +383,7 @@ typedef struct checkpoint_state {
     uint64_t fingerprint;
     uint32_t options_size;
     vf_field_train_options options;
-    int32_t step, level, loss_count, adam_t;
+    int32_t step, level, loss_count, adam_t, appearance_t;
     float final_voxel;
     double elapsed, loss_avg;
     vf_rng rng;
@@ -402,6 +403,7 @@ vf_status vf_field_trainer_save_checkpoint(vf_field_trainer *t, const char *path
     st.level = t->level;
     st.loss_count = t->loss_count;
     st.adam_t = t->adam.t;
+    st.appearance_t = t->appearance_t;
     st.final_voxel = t->final_voxel;
     st.elapsed = t->elapsed_before + (vf_now() - t->start_time);
     st.loss_avg = t->loss_avg;
@@ -422,6 +424,8 @@ vf_status vf_field_trainer_save_checkpoint(vf_field_trainer *t, const char *path
         put(&s, t->adam.m[i], bytes);
         put(&s, t->adam.v[i], bytes);
     }
+    if (t->appearance) /* values and moments */
+        put(&s, t->appearance, 3 * 6 * (size_t)t->view_count * sizeof *t->appearance);
     status = finish_write(&s, tmp);
     /* the budget is for training: a run that checkpoints gets the steps of one that does not */
     t->start_time += vf_now() - began;
@@ -488,6 +492,8 @@ vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
         get(&s, t->adam.m[i], bytes);
         get(&s, t->adam.v[i], bytes);
     }
+    if (status == VF_OK && (status = vf__trainer_alloc_appearance(t)) == VF_OK && t->appearance)
+        get(&s, t->appearance, 3 * 6 * (size_t)t->view_count * sizeof *t->appearance);
     if (status != VF_OK) {
         fclose(s.fp);
         return status;
@@ -495,6 +501,7 @@ vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
     if ((status = finish_read(&s, "delete it to start afresh")) != VF_OK)
         return status;
     t->adam.t = st.adam_t;
+    t->appearance_t = st.appearance_t;
     return VF_OK;
 }
 

@@ -348,6 +348,8 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         topt.tv_view = from_model ? MODEL_VIEW_SMOOTHING : 0.0f;
     if (opt->depth >= 0)
         topt.depth = (float)opt->depth;
+    if (opt->appearance)
+        topt.appearance = VF_FIELD_APPEARANCE_RATE;
     vf_field_trainer *t = NULL;
     vf_stage stage;
     char checkpoint[VF_PATH_MAX], model[VF_PATH_MAX], report_path[VF_PATH_MAX];
@@ -442,6 +444,7 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         json_object_set_new(report, "levels", json_integer(used->levels));
         /* the distortion loss acts on opaque photos only */
         json_object_set_new(report, "distortion", json_real(with_alpha ? 0.0 : used->distortion));
+        json_object_set_new(report, "appearance", json_real(with_alpha ? 0.0 : used->appearance));
         /* the training photos' sightings of sparse points given to the depth loss (0: off) */
         const long supervising = used->depth > 0 && !with_alpha ? point_total : 0;
         json_object_set_new(report, "depth_points", json_integer(supervising));
@@ -471,13 +474,14 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                                        ssim, "steps", st.step)
                            : json_pack("{s:i}", "steps", st.step);
     status = vf_stage_commit(&stage,
-                             json_pack("{s:f, s:i, s:i, s:s, s:s, s:f, s:f, s:b}", "minutes",
+                             json_pack("{s:f, s:i, s:i, s:s, s:s, s:f, s:f, s:b, s:b}", "minutes",
                                        minutes, "steps", opt->steps, "holdout", opt->holdout,
                                        "surroundings",
                                        vf_field_surroundings_name(opt->surroundings), "color",
                                        vf_field_color_name(opt->color), "view_smoothing",
                                        (double)topt.tv_view, "depth", (double)topt.depth,
-                                       "object_only", opt->object_only),
+                                       "appearance", opt->appearance, "object_only",
+                                       opt->object_only),
                              json_incref(summary));
     /* The checkpoint goes only once the stage is in place: after a failed commit the next run
      * resumes from it at its end instead of training again. */

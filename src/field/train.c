@@ -41,6 +41,7 @@ void vf_field_train_defaults(vf_field_train_options *opt)
     opt->distortion = 0.01f;
     opt->depth = 10;
     opt->prune_alpha = 0.1f;
+    opt->appearance = 0;
     opt->seed = 1;
     opt->threads = 0;
 }
@@ -72,6 +73,8 @@ static vf_status check_options(const vf_field_train_options *o)
         return vf_fail(VF_EINPUT, "distortion weight %g is out of range", o->distortion);
     if (!(o->depth >= 0 && o->depth <= 1e4))
         return vf_fail(VF_EINPUT, "depth weight %g is out of range", o->depth);
+    if (!(o->appearance >= 0 && o->appearance <= 1))
+        return vf_fail(VF_EINPUT, "appearance learning rate %g is out of range", o->appearance);
     if (!(o->prune_alpha >= 0 && o->prune_alpha < 1))
         return vf_fail(VF_EINPUT, "prune_alpha must be in [0, 1)");
     return VF_OK;
@@ -102,6 +105,8 @@ void vf_field_trainer_free(vf_field_trainer *t)
     for (int i = 0; t->scratch && i < t->threads; i++)
         free(t->scratch[i].samples);
     free(t->scratch);
+    free(t->appearance);
+    free(t->appearance_grad);
     vf_field_free(t->field);
     free(t);
 }
@@ -165,6 +170,8 @@ vf_status vf_field_trainer_start(vf_field_trainer *t)
         status = vf__trainer_build_pool(t);
     if (status == VF_OK)
         status = prepare_level(t);
+    if (status == VF_OK)
+        status = vf__trainer_alloc_appearance(t);
     return status;
 }
 
@@ -343,10 +350,24 @@ static double run_batch(vf_field_trainer *t, const uint32_t *pixels, const float
         vf__trainer_pixel_ray(t, pixels[i], &ray, target);
         vf__field_march(f, &ray, jitter[i], 1e-4f, &t->scratch[me], &res);
         float dl[3];
-        for (int k = 0; k < 3; k++) {
-            float err = res.rgb[k] - target[k];
-            sse += (double)err * err;
-            dl[k] = loss_scale * err;
+        if (t->appearance) {
+            /* the photo sees (1 + gain) * c + offset */
+            const int v = vf__trainer_pixel_view(t, pixels[i]);
+            const float *a = t->appearance + 6 * (size_t)v;
+            double *grad = t->appearance_grad + 6 * ((size_t)me * t->view_count + v);
+            for (int k = 0; k < 3; k++) {
+                float err = (1 + a[k]) * res.rgb[k] + a[3 + k] - target[k];
+                sse += (double)err * err;
+                dl[k] = loss_scale * err * (1 + a[k]);
+                grad[k] += loss_scale * err * res.rgb[k];
+                grad[3 + k] += loss_scale * err;
+            }
+        } else {
+            for (int k = 0; k < 3; k++) {
+                float err = res.rgb[k] - target[k];
+                sse += (double)err * err;
+                dl[k] = loss_scale * err;
+            }
         }
         field_ray_losses ray_losses = losses;
         if (depth[i] > 0) {
@@ -436,6 +457,8 @@ vf_status vf_field_trainer_step(vf_field_trainer *t, vf_field_train_status *stat
         lr[ch] = diffuse && (ch - FIELD_CH_SH) % 4 ? 0.0f : t->opt.lr_color * decay;
     t->last_touched = (double)vf__field_adam_touched(&t->adam);
     vf__field_adam_step(&t->adam, f, lr, t->opt.tv_density, t->opt.tv_color, t->opt.tv_view);
+    if (t->appearance)
+        vf__trainer_appearance_step(t, t->opt.appearance * decay);
     t->last_samples_per_ray = (double)samples / rays;
     t->last_step_ms = (t1 - t0) * 1000;
     t->last_optimizer_ms = (vf_now() - t1) * 1000;

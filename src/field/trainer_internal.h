@@ -1,6 +1,6 @@
 /* src/field/trainer_internal.h: the training state shared by train.c (the loop),
- * train_views.c (the photos as rays), carve.c (scene box, visual hull), adam.c (optimizer)
- * and model_io.c (checkpoints). */
+ * train_views.c (the photos as rays), carve.c (scene box, visual hull), adam.c (optimizer,
+ * and the photos' appearance) and model_io.c (checkpoints). */
 #ifndef VF_FIELD_TRAINER_INTERNAL_H
 #define VF_FIELD_TRAINER_INTERNAL_H
 
@@ -81,6 +81,13 @@ struct vf_field_trainer {
     float final_voxel;
     vf_rng rng;
 
+    /* each photo's appearance (opaque photos, opt.appearance > 0): the render's colour c is
+     * compared as (1 + gain) * c + offset; 6 floats a view (gain, offset), their Adam moments,
+     * and each thread's gradients (6 doubles a view) */
+    float *appearance, *appearance_m, *appearance_v;
+    double *appearance_grad;
+    int appearance_t;
+
     /* progress */
     int started, done;
     int step;
@@ -149,6 +156,14 @@ void vf__field_adam_free(field_adam *adam);
  * lr[ch] is the learning rate of channel ch. */
 void vf__field_adam_step(field_adam *adam, vf_field *f, const float lr[FIELD_CH], float tv_density,
                          float tv_color, float tv_view);
+
+/* Each opaque photo's appearance (gain and offset per channel, from 0), their Adam moments
+ * and the threads' gradients, when opt.appearance asks for them and they are missing. */
+vf_status vf__trainer_alloc_appearance(vf_field_trainer *t);
+
+/* One Adam step on the photos' appearance from the threads' gradients (cleared), then the
+ * mean over the photos taken out: the field keeps the photos' mean look, which renders show. */
+void vf__trainer_appearance_step(vf_field_trainer *t, float lr);
 
 /* Number of distinct points touched (for statistics). */
 size_t vf__field_adam_touched(const field_adam *adam);
