@@ -27,6 +27,8 @@ static const char usage[] =
     "      --train-steps N  train for N steps instead (the same field on a busy machine)\n"
     "      --object-only    object mode: the object cut out of the field, on white (see\n"
     "                       'vfcapture train --help')\n"
+    "      --appearance     learn each photo's exposure and white balance beside the field\n"
+    "                       (see 'vfcapture train --help')\n"
     "      --samples K      attack samples per step (default 50)\n"
     "      --steps S        attack steps (default 100)\n"
     "      --restart        redo every stage, even those that are up to date\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
@@ -37,7 +39,8 @@ enum {
     OPT_SAMPLES,
     OPT_STEPS,
     OPT_RESTART,
-    OPT_OBJECT_ONLY
+    OPT_OBJECT_ONLY,
+    OPT_APPEARANCE
 };
 
 typedef struct run_options {
@@ -61,6 +64,7 @@ static vf_status parse_options(int argc, char **argv, run_options *o)
         {"steps", required_argument, NULL, OPT_STEPS},
         {"restart", no_argument, NULL, OPT_RESTART},
         {"object-only", no_argument, NULL, OPT_OBJECT_ONLY},
+        {"appearance", no_argument, NULL, OPT_APPEARANCE},
         {0, 0, 0, 0},
     };
     vf_run_defaults(&o->run);
@@ -92,6 +96,7 @@ static vf_status parse_options(int argc, char **argv, run_options *o)
         case OPT_STEPS: s = cli_count_int("--steps", optarg, 0, 100000, &o->run.attack.steps); break;
         case OPT_RESTART: o->run.restart = 1; break;
         case OPT_OBJECT_ONLY: o->run.train.object_only = 1; break;
+        case OPT_APPEARANCE: o->run.train.appearance = 1; break;
         }
     }
     if (s != VF_OK)

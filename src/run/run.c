@@ -84,6 +84,8 @@ static int plan_stages(const vf_run_options *o, stage_call *calls)
                               o->train.steps)};
     if (o->train.object_only) /* the key only when set: older workspaces stay current */
         json_object_set_new(calls[n - 1].settings, "object_only", json_true());
+    if (o->train.appearance)
+        json_object_set_new(calls[n - 1].settings, "appearance", json_true());
     calls[n++] = (stage_call){
         .name = "attack",
         .which = ATTACK,
