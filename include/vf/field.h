@@ -258,7 +258,8 @@ typedef struct vf_field_train_options {
                                 VF_FIELD_APPEARANCE_RATE is `train --appearance`. At 3 minutes
                                 (bench_field, every 8th photo held out and shown at the mean):
                                 the wall clock named like its photos 51 -> 62% and 54 -> 65%
-                                (seeds 1, 2), held-out 22.27 -> 21.85 and 22.44 -> 21.85 dB;
+                                (seeds 1, 2), held-out 22.27 -> 21.85 and 22.44 -> 21.85 dB
+                                (colour matched to each photo: 22.57 -> 22.84 dB, seed 2);
                                 the shoes 66 -> 69%, 30.14 -> 29.99 dB; the fox 40 -> 40%,
                                 27.38 -> 26.43 dB; the apple 21 -> 21%, 22.93 -> 22.09 dB */
     float carve_share;       /* photos with alpha: a point of the box is carved away when at
