@@ -242,7 +242,7 @@ vf_status vf__trainer_alloc_appearance(vf_field_trainer *t)
 void vf__trainer_appearance_step(vf_field_trainer *t, float lr)
 {
     const size_t n = 6 * (size_t)t->view_count;
-    const float beta1 = 0.9f, beta2 = 0.99f;
+    const float beta1 = t->adam.beta1, beta2 = t->adam.beta2; /* the field's */
     t->appearance_t++;
     const float c1 = 1.0f - powf(beta1, (float)t->appearance_t);
     const float c2 = 1.0f - powf(beta2, (float)t->appearance_t);
@@ -256,7 +256,7 @@ void vf__trainer_appearance_step(vf_field_trainer *t, float lr)
         float *m = &t->appearance_m[i], *v = &t->appearance_v[i];
         *m = beta1 * *m + (1 - beta1) * (float)g;
         *v = beta2 * *v + (1 - beta2) * (float)(g * g);
-        t->appearance[i] -= lr * (*m / c1) / (sqrtf(*v / c2) + 1e-8f);
+        t->appearance[i] -= lr * (*m / c1) / (sqrtf(*v / c2) + t->adam.eps);
         mean[i % 6] += t->appearance[i];
     }
     for (size_t i = 0; i < n; i++)

@@ -349,24 +349,23 @@ static double run_batch(vf_field_trainer *t, const uint32_t *pixels, const float
         field_march_result res;
         vf__trainer_pixel_ray(t, pixels[i], &ray, target);
         vf__field_march(f, &ray, jitter[i], 1e-4f, &t->scratch[me], &res);
-        float dl[3];
+        /* the photo sees (1 + gain) * c + offset, gain and offset 0 without its appearance */
+        const float *a = NULL;
+        double *grad = NULL;
         if (t->appearance) {
-            /* the photo sees (1 + gain) * c + offset */
             const int v = vf__trainer_pixel_view(t, pixels[i]);
-            const float *a = t->appearance + 6 * (size_t)v;
-            double *grad = t->appearance_grad + 6 * ((size_t)me * t->view_count + v);
-            for (int k = 0; k < 3; k++) {
-                float err = (1 + a[k]) * res.rgb[k] + a[3 + k] - target[k];
-                sse += (double)err * err;
-                dl[k] = loss_scale * err * (1 + a[k]);
+            a = t->appearance + 6 * (size_t)v;
+            grad = t->appearance_grad + 6 * ((size_t)me * t->view_count + v);
+        }
+        float dl[3];
+        for (int k = 0; k < 3; k++) {
+            const float gain = a ? 1 + a[k] : 1.0f, offset = a ? a[3 + k] : 0.0f;
+            const float err = gain * res.rgb[k] + offset - target[k];
+            sse += (double)err * err;
+            dl[k] = loss_scale * err * gain;
+            if (grad) {
                 grad[k] += loss_scale * err * res.rgb[k];
                 grad[3 + k] += loss_scale * err;
-            }
-        } else {
-            for (int k = 0; k < 3; k++) {
-                float err = res.rgb[k] - target[k];
-                sse += (double)err * err;
-                dl[k] = loss_scale * err;
             }
         }
         field_ray_losses ray_losses = losses;
