@@ -2,6 +2,8 @@
  * that is aborted leaves the earlier output exactly as it was. */
 #include <stdio.h>
 #include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "vf/ingest.h"
@@ -175,6 +177,107 @@ static void test_stage_swap(void)
     CHECK(file_says(path, "{broken"), "corrupt manifest left for the user to inspect");
 }
 
+/* Several processes commit different stages of one workspace at once, each through the handle
+ * it opened at the start (as a study's parallel jobs do): every record must survive. Without a
+ * lock around the manifest's read-modify-write, each commit wrote back the manifest its process
+ * had read, and the others' records were lost. */
+static void test_concurrent_commits(void)
+{
+    enum { PROCESSES = 4, ROUNDS = 25 };
+    char root[VF_PATH_MAX];
+    vf_path_join(root, sizeof root, vf_test_tmpdir(), "ws_concurrent");
+    vf_workspace ws;
+    CHECK(vf_workspace_open(root, 1, &ws) == VF_OK, "create: %s", vf_error_message());
+    vf_workspace_close(&ws);
+    pid_t pids[PROCESSES];
+    for (int p = 0; p < PROCESSES; p++) {
+        pids[p] = fork();
+        if (pids[p] == 0) {
+            vf_workspace mine;
+            int failed = vf_workspace_open(root, 0, &mine) != VF_OK;
+            for (int r = 0; r < ROUNDS && !failed; r++) {
+                char name[32];
+                vf_stage s;
+                snprintf(name, sizeof name, "p%d_r%d", p, r);
+                failed = vf_stage_begin(&mine, name, &s) != VF_OK ||
+                         vf_stage_commit(&s, json_pack("{s:i}", "round", r), NULL) != VF_OK;
+            }
+            vf_workspace_close(&mine);
+            _exit(failed);
+        }
+    }
+    int children_ok = 1;
+    for (int p = 0; p < PROCESSES; p++) {
+        int status = 0;
+        children_ok &= pids[p] > 0 && waitpid(pids[p], &status, 0) == pids[p] &&
+                       WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    }
+    CHECK(children_ok, "every process committed its stages");
+    CHECK(vf_workspace_open(root, 0, &ws) == VF_OK, "reopen: %s", vf_error_message());
+    int kept = 0;
+    for (int p = 0; p < PROCESSES; p++)
+        for (int r = 0; r < ROUNDS; r++) {
+            char name[32];
+            snprintf(name, sizeof name, "p%d_r%d", p, r);
+            kept += vf_workspace_has_stage(&ws, name);
+        }
+    CHECK(kept == PROCESSES * ROUNDS, "the manifest keeps %d of the %d records committed", kept,
+          PROCESSES * ROUNDS);
+    vf_workspace_close(&ws);
+}
+
+/* Rerunning a stage makes what was built on it stale, all the way down: later stages refuse
+ * with one line naming what to rerun, and rerunning them in order makes them current again.
+ * A second run of a stage is refused while the first still holds it. */
+static void test_staleness(void)
+{
+    char root[VF_PATH_MAX];
+    vf_path_join(root, sizeof root, vf_test_tmpdir(), "ws_stale");
+    vf_workspace ws;
+    vf_stage s, second;
+    CHECK(vf_workspace_open(root, 1, &ws) == VF_OK, "create: %s", vf_error_message());
+    const char *chain[] = {"ingest", "poses", "train"};
+    for (int i = 0; i < 3; i++)
+        CHECK(vf_stage_begin(&ws, chain[i], &s) == VF_OK && vf_stage_commit(&s, NULL, NULL) == VF_OK,
+              "%s: %s", chain[i], vf_error_message());
+    CHECK(vf_workspace_need(&ws, "train") == VF_OK, "a fresh chain is current");
+    CHECK(vf_workspace_need(&ws, "attack") == VF_EINPUT &&
+              strstr(vf_error_message(), "vfcapture attack") != NULL,
+          "a missing stage names its command: %s", vf_error_message());
+
+    /* Another ingest: poses and train are stale, and nothing reads them silently. */
+    CHECK(vf_stage_begin(&ws, "ingest", &s) == VF_OK && vf_stage_commit(&s, NULL, NULL) == VF_OK,
+          "re-ingest");
+    char why[256];
+    CHECK(vf_workspace_is_stale(&ws, "poses", why, sizeof why) && strstr(why, "ingest"),
+          "poses stale: %s", why);
+    CHECK(vf_workspace_is_stale(&ws, "train", why, sizeof why), "train stale through poses");
+    CHECK(vf_workspace_need(&ws, "train") == VF_EINPUT && strstr(vf_error_message(), "stale"),
+          "need(train): %s", vf_error_message());
+    CHECK(vf_stage_begin(&ws, "attack", &s) == VF_EINPUT && strstr(vf_error_message(), "train"),
+          "attack on a stale field refused: %s", vf_error_message());
+    CHECK(vf_stage_begin(&ws, "train", &s) == VF_EINPUT && strstr(vf_error_message(), "poses"),
+          "train on stale poses refused: %s", vf_error_message());
+
+    /* The same stage twice at once: the second is refused until the first ends. */
+    CHECK(vf_stage_begin(&ws, "poses", &s) == VF_OK, "rerun poses");
+    vf_workspace other;
+    CHECK(vf_workspace_open(root, 0, &other) == VF_OK, "second handle");
+    pid_t child = fork();
+    if (child == 0) /* fcntl locks are per process: try from another one */
+        _exit(vf_stage_begin(&other, "poses", &second) == VF_OK ? 1 : 0);
+    int status = 0;
+    CHECK(waitpid(child, &status, 0) == child && WIFEXITED(status) && WEXITSTATUS(status) == 0,
+          "a second poses while the first runs is refused");
+    vf_workspace_close(&other);
+    CHECK(vf_stage_commit(&s, NULL, NULL) == VF_OK, "poses committed");
+    CHECK(!vf_workspace_is_stale(&ws, "poses", NULL, 0), "rerun poses is current");
+    CHECK(vf_stage_begin(&ws, "train", &s) == VF_OK && vf_stage_commit(&s, NULL, NULL) == VF_OK,
+          "rerun train: %s", vf_error_message());
+    CHECK(vf_workspace_need(&ws, "train") == VF_OK, "the chain is current again");
+    vf_workspace_close(&ws);
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
@@ -182,5 +285,7 @@ int main(int argc, char **argv)
     CHECK_CASE(test_error_chaining);
     CHECK_CASE(test_stage_swap);
     CHECK_CASE(test_ingest_failed_commit);
+    CHECK_CASE(test_concurrent_commits);
+    CHECK_CASE(test_staleness);
     return check_finish();
 }

@@ -514,6 +514,8 @@ vf_status vf_field_load_workspace(const vf_workspace *ws, vf_field **out)
                        "workspace %s has no trained radiance field: run 'vfcapture "
                        "train %s' first",
                        ws->root, ws->root);
+    if (vf_workspace_is_stale(ws, "train", NULL, 0)) /* poses or ingest rerun since */
+        return vf_workspace_need(ws, "train");
     vf_status s = vf_workspace_path(ws, "train", VF_FIELD_FILE, path, sizeof path);
     return s == VF_OK ? vf_field_load(path, out) : s;
 }
