@@ -106,14 +106,21 @@ static void method_row(const options *o, const object_spec *obj, const char *ws,
     char saved[VF_PATH_MAX * 2];
     snprintf(saved, sizeof saved, "%s/table1_%s.json", ws, methods[m].name);
     if (!vf_is_file(saved)) {
-        if (bench_run("'%s' attack '%s' --label %s --space both %s --steps %d --quiet",
-                      bench_tool(), ws, obj->labels, methods[m].args, o->steps) ||
-            bench_run("'%s' real '%s' --fluctuation-samples %d --natural-views %d --quiet",
-                      bench_tool(), ws, o->fluct, o->natural))
+        /* each method is its own attack of the workspace (attack/NAME), so all three stay */
+        const char *name = methods[m].name;
+        char real_file[160], attack_stage[160], real_stage[160];
+        snprintf(real_file, sizeof real_file, "real/%s/real.json", name);
+        snprintf(attack_stage, sizeof attack_stage, "attack/%s", name);
+        snprintf(real_stage, sizeof real_stage, "real/%s", name);
+        if (bench_run("'%s' attack '%s' --attack %s --label %s --space both %s --steps %d --quiet",
+                      bench_tool(), ws, name, obj->labels, methods[m].args, o->steps) ||
+            bench_run("'%s' real '%s' --attack %s --fluctuation-samples %d --natural-views %d "
+                      "--quiet",
+                      bench_tool(), ws, name, o->fluct, o->natural))
             return;
-        json_t *real = load(ws, "real/real.json");
-        json_object_set_new(real, "attack_seconds", json_real(stage_seconds(ws, "attack")));
-        json_object_set_new(real, "real_seconds", json_real(stage_seconds(ws, "real")));
+        json_t *real = load(ws, real_file);
+        json_object_set_new(real, "attack_seconds", json_real(stage_seconds(ws, attack_stage)));
+        json_object_set_new(real, "real_seconds", json_real(stage_seconds(ws, real_stage)));
         json_object_del(real, "views");
         json_dump_file(real, saved, JSON_INDENT(1));
         json_decref(real);

@@ -15,7 +15,7 @@
 #include "vf/workspace.h"
 
 /* The long options every command accepts; put CLI_COMMON_OPTIONS first in its table. */
-enum { CLI_OPT_JSON = 1000, CLI_OPT_ENGINE, CLI_OPT_FIRST_CUSTOM = 1100 };
+enum { CLI_OPT_JSON = 1000, CLI_OPT_ENGINE, CLI_OPT_ATTACK, CLI_OPT_FIRST_CUSTOM = 1100 };
 #define CLI_COMMON_OPTIONS                                                                 \
     {"help", no_argument, NULL, 'h'}, {"quiet", no_argument, NULL, 'q'},                   \
         {"json", no_argument, NULL, CLI_OPT_JSON}
@@ -31,6 +31,13 @@ enum { CLI_OPT_JSON = 1000, CLI_OPT_ENGINE, CLI_OPT_FIRST_CUSTOM = 1100 };
 #define CLI_ENGINE_HELP                                                                        \
     "      --engine E     classifier engine: auto (default: onnxruntime when installed, else\n" \
     "                     opencv), onnxruntime or opencv; also $VF_ENGINE\n"
+
+/* Commands that read an attack (and attack itself, which names the one it makes) put
+ * CLI_ATTACK_OPTION in their table and handle CLI_OPT_ATTACK: the attack's name. */
+#define CLI_ATTACK_OPTION {"attack", required_argument, NULL, CLI_OPT_ATTACK}
+#define CLI_ATTACK_HELP                                                                         \
+    "      --attack NAME      which of the workspace's attacks (WS/attack/NAME/); needed only\n" \
+    "                         when it has several\n"
 
 typedef struct cli_flags {
     int json;

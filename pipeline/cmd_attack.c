@@ -15,13 +15,15 @@ static const char usage[] =
     "                       [--method nes|pepg|random] [--lambda X] [--samples K] [--steps N] "
     "[--components K]\n"
     "                       [--space rotation|translation|both] [--bounds name=lo:hi,...]\n"
-    "                       [--seed S] [--restart] [--json]\n"
+    "                       [--seed S] [--attack NAME] [--restart] [--json]\n"
     "\n"
     "Find the viewpoints from which the classifier misreads the object (ViewFool, Dong et al.,\n"
     "NeurIPS 2022): learn a distribution p(v) over viewpoints v = (psi, theta, phi in degrees,\n"
     "dx, dy, dz in scene units) that maximizes the cross-entropy of the true label set on\n"
-    "renders of the trained field, plus lambda times its entropy. Writes WS/attack/attack.json,\n"
-    "v_star.png, samples.png, loss.png and fluctuation.png.\n"
+    "renders of the trained field, plus lambda times its entropy. Writes WS/attack/NAME/:\n"
+    "attack.json, v_star.png, samples.png, loss.png and fluctuation.png. A workspace keeps\n"
+    "several attacks side by side; NAME is made of the model, the method, lambda and the\n"
+    "space (mobilenet_v2_1.0_224_quant-nes-l0.01-both) unless --attack gives it.\n"
     "\n"
     "options:\n"
     "  -m, --model NAME|PATH  ImageNet classifier (default " VF_DEFAULT_MODEL ")\n"
@@ -45,6 +47,8 @@ static const char usage[] =
     "                         phi 20:160, dx -0.5:0.5, dy -1:1, dz -0.5:0.5; for a real capture\n"
     "                         (poses stage) the range its photos cover\n"
     "      --seed S           random seed (default 0): the same seed gives the same result\n"
+    "      --attack NAME      the attack's name (default: model-method-lLAMBDA-space); the\n"
+    "                         same name again replaces that attack\n"
     "      --restart          discard an interrupted attack (by default a run with the same\n"
     "                         settings continues it from its last step)\n" CLI_ENGINE_HELP
         CLI_COMMON_HELP;
@@ -90,6 +94,7 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
         CLI_ENGINE_OPTION,
+        CLI_ATTACK_OPTION,
         {"model", required_argument, NULL, 'm'},
         {"models-dir", required_argument, NULL, OPT_MODELS_DIR},
         {"label", required_argument, NULL, 'l'},
@@ -138,6 +143,7 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
                 s = vf_fail(VF_EINPUT, "--seed must be a whole number >= 0, not '%s'", optarg);
             break;
         case OPT_RESTART: o->restart = 1; break;
+        case CLI_OPT_ATTACK: o->name = optarg; break;
         default: break;
         }
     }
@@ -212,8 +218,13 @@ static void print_summary(const attack_cli *cli, const json_t *doc)
         printf("%s %s (%lld)", i ? "," : "", class_of(w),
                json_integer_value(json_object_get(w, "count")));
     }
-    printf("%s\nwritten: %s/attack/{attack.json, v_star.png, samples.png, %sfluctuation.png}\n",
-           json_array_size(wrong) ? "" : " none", cli->workspace, random ? "" : "loss.png, ");
+    char name[128];
+    if (cli->attack.name)
+        snprintf(name, sizeof name, "%s", cli->attack.name);
+    else
+        vf_attack_default_name(&cli->attack, name, sizeof name);
+    printf("%s\nwritten: %s/attack/%s/{attack.json, v_star.png, samples.png, %sfluctuation.png}\n",
+           json_array_size(wrong) ? "" : " none", cli->workspace, name, random ? "" : "loss.png, ");
 }
 
 int cmd_attack(int argc, char **argv)

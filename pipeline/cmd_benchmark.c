@@ -13,7 +13,7 @@
 #define MAX_MODELS 32
 
 static const char usage[] =
-    "usage: vfcapture benchmark build WS... -o DIR [--count N] [--seed S]\n"
+    "usage: vfcapture benchmark build WS... -o DIR [--count N] [--seed S] [--attack NAME]\n"
     "       vfcapture benchmark eval DIR [--models A,B,...|all] [--json]\n"
     "\n"
     "build: for each attacked workspace, render N images at viewpoints sampled from its\n"
@@ -28,6 +28,8 @@ static const char usage[] =
     "  -o, --output DIR       build: the folder to create\n"
     "  -n, --count N          build: images per object and split (default 100)\n"
     "      --seed S           build: sampling seed (default 0)\n"
+    "      --attack NAME      build: which attack of each workspace (needed only when one has\n"
+    "                         several)\n"
     "      --models LIST      eval: model names or .onnx paths, comma-separated, or 'all' for\n"
     "                         every model found by name (see vfcapture models; default " VF_DEFAULT_MODEL
     ")\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
@@ -45,6 +47,7 @@ static vf_status parse_options(int argc, char **argv, benchmark_options *opt)
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
         CLI_ENGINE_OPTION,
+        CLI_ATTACK_OPTION,
         {"output", required_argument, NULL, 'o'},
         {"count", required_argument, NULL, 'n'},
         {"seed", required_argument, NULL, OPT_SEED},
@@ -68,6 +71,8 @@ static vf_status parse_options(int argc, char **argv, benchmark_options *opt)
             opt->build.seed = (uint64_t)value;
         } else if (c == OPT_MODELS) {
             opt->models = optarg;
+        } else if (c == CLI_OPT_ATTACK) {
+            opt->build.attack = optarg;
         }
     }
     return VF_OK;

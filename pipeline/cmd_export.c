@@ -6,9 +6,9 @@
 #include "vf/export.h"
 
 static const char usage[] =
-    "usage: vfcapture export WS [--count M]\n"
+    "usage: vfcapture export WS [--count M] [--attack NAME]\n"
     "\n"
-    "Turn the attack's result (WS/attack/attack.json) into target shots: v* and M samples of\n"
+    "Turn an attack's result (WS/attack/NAME/attack.json) into target shots: v* and M samples of\n"
     "p*(v) spread over the distribution. For each: camera-to-world in the object frame and in\n"
     "COLMAP's frame (when WS has poses), and in words (azimuth and elevation around the object\n"
     "centre, distance, height, roll, the point looked at; metres when WS/calib/scale.json gives\n"
@@ -17,14 +17,15 @@ static const char usage[] =
     "Writes WS/export/targets.json, targets.csv, previews/ and shot_card.png.\n"
     "\n"
     "options:\n"
-    "  -n, --count M          samples of p*(v) besides v* (default 8)\n" CLI_ENGINE_HELP
-        CLI_COMMON_HELP;
+    "  -n, --count M          samples of p*(v) besides v* (default 8)\n" CLI_ATTACK_HELP
+        CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 static vf_status parse(int argc, char **argv, const char **ws, vf_export_options *o,
                        cli_flags *flags)
 {
     static const struct option longopts[] = {CLI_COMMON_OPTIONS,
                                              CLI_ENGINE_OPTION,
+                                             CLI_ATTACK_OPTION,
                                              {"count", required_argument, NULL, 'n'},
                                              {0, 0, 0, 0}};
     int c;
@@ -32,6 +33,8 @@ static vf_status parse(int argc, char **argv, const char **ws, vf_export_options
     while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "n:", longopts, NULL)) != -1) {
         if (cli_common_option(c, flags, "export", usage))
             continue;
+        if (c == CLI_OPT_ATTACK)
+            o->attack = optarg;
         if (c == 'n') {
             if (cli_parse_int(optarg, 0, VF_EXPORT_MAX_COUNT, &n))
                 return vf_fail(VF_EINPUT, "--count: give a number from 0 to %d",

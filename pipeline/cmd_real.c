@@ -12,7 +12,7 @@
 
 static const char usage[] =
     "usage: vfcapture real WS [--model NAME|PATH] [--fluctuation-samples N] [--natural-views N]\n"
-    "                         [--seed S] [--json]\n"
+    "                         [--seed S] [--attack NAME] [--json]\n"
     "\n"
     "For a workspace made from a 3D model (vfcapture ingest MODEL.glb) or filmed by the studio\n"
     "(vfcapture simulate capture: its truth file places the model), after attack: render\n"
@@ -20,8 +20,9 @@ static const char usage[] =
     "of p*(v), at fluctuation points around v* and at natural training views, and classify\n"
     "them beside the field's renders at the same cameras. Reports the paper's Real(v*) and\n"
     "Real(p*(v)) beside the rendered ASR, both fluctuation curves and both natural accuracies.\n"
-    "Writes WS/real/real.json, sheet.png (field | object for v* and samples), fluctuation.png\n"
-    "and the object's renders. An interrupted run continues where it stopped.\n"
+    "Writes WS/real/NAME/ for the attack NAME: real.json, sheet.png (field | object for v* and\n"
+    "samples), fluctuation.png and the object's renders. An interrupted run continues where it\n"
+    "stopped.\n"
     "\n"
     "options:\n"
     "  -m, --model NAME|PATH  classifier (default: the one the attack used)\n"
@@ -29,7 +30,8 @@ static const char usage[] =
     "      --fluctuation-samples N\n"
     "                         viewpoints a fluctuation level r = 1..10% (default 20)\n"
     "      --natural-views N  training views checked, spread over them (default 100)\n"
-    "      --seed S           draws of the fluctuation boxes (default 0)\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
+    "      --seed S           draws of the fluctuation boxes (default 0)\n" CLI_ATTACK_HELP
+        CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum { OPT_MODELS_DIR = CLI_OPT_FIRST_CUSTOM, OPT_FLUCT, OPT_NATURAL, OPT_SEED };
 
@@ -44,6 +46,7 @@ static vf_status parse_options(int argc, char **argv, real_options *opt)
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
         CLI_ENGINE_OPTION,
+        CLI_ATTACK_OPTION,
         {"model", required_argument, NULL, 'm'},
         {"models-dir", required_argument, NULL, OPT_MODELS_DIR},
         {"fluctuation-samples", required_argument, NULL, OPT_FLUCT},
@@ -63,6 +66,8 @@ static vf_status parse_options(int argc, char **argv, real_options *opt)
             opt->real.classifier = optarg;
         else if (c == OPT_MODELS_DIR)
             opt->real.models_dir = optarg;
+        else if (c == CLI_OPT_ATTACK)
+            opt->real.attack = optarg;
         else if (c == OPT_FLUCT && (s = cli_count("--fluctuation-samples", optarg, 1, 1000, &n)) == VF_OK)
             opt->real.fluctuation_samples = (int)n;
         else if (c == OPT_NATURAL && (s = cli_count("--natural-views", optarg, 1, 100000, &n)) == VF_OK)

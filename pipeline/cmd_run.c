@@ -31,6 +31,8 @@ static const char usage[] =
     "                       (see 'vfcapture train --help')\n"
     "      --samples K      attack samples per step (default 50)\n"
     "      --steps S        attack steps (default 100)\n"
+    "      --attack NAME    the attack's name (default: model-method-lLAMBDA-space, see\n"
+    "                       'vfcapture attack --help'); real and export use it\n"
     "      --restart        redo every stage, even those that are up to date\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 enum {
@@ -54,6 +56,7 @@ static vf_status parse_options(int argc, char **argv, run_options *o)
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
         CLI_ENGINE_OPTION,
+        CLI_ATTACK_OPTION,
         {"output", required_argument, NULL, 'o'},
         {"model", required_argument, NULL, 'm'},
         {"label", required_argument, NULL, 'l'},
@@ -95,6 +98,7 @@ static vf_status parse_options(int argc, char **argv, run_options *o)
             break;
         case OPT_STEPS: s = cli_count_int("--steps", optarg, 0, 100000, &o->run.attack.steps); break;
         case OPT_RESTART: o->run.restart = 1; break;
+        case CLI_OPT_ATTACK: o->run.attack.name = optarg; break;
         case OPT_OBJECT_ONLY: o->run.train.object_only = 1; break;
         case OPT_APPEARANCE: o->run.train.appearance = 1; break;
         }

@@ -12,22 +12,24 @@
 #define MAX_MODELS 16
 
 static const char usage[] =
-    "usage: vfcapture transfer WS --models A,B,... [--models-dir DIR] [--json]\n"
+    "usage: vfcapture transfer WS --models A,B,... [--models-dir DIR] [--attack NAME] [--json]\n"
     "\n"
     "Measure how the viewpoints found by 'vfcapture attack' transfer to other ImageNet models:\n"
     "for each model, the natural accuracy over the training views, the attack success rate of\n"
     "v* and over the attack's 100 samples of p*(v), with the attack's label set. Models of any\n"
-    "input size work (renders keep the field of view). Writes WS/transfer/transfer.json.\n"
+    "input size work (renders keep the field of view). Writes WS/transfer/NAME/transfer.json\n"
+    "for the attack NAME.\n"
     "\n"
     "options:\n"
     "      --models A,B,...   model names (see vfcapture models) or .onnx paths; CNNs and\n"
     "                         transformers may be mixed\n"
-    "      --models-dir DIR   look for model names here first\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
+    "      --models-dir DIR   look for model names here first\n" CLI_ATTACK_HELP CLI_ENGINE_HELP
+        CLI_COMMON_HELP;
 
 enum { OPT_MODELS = CLI_OPT_FIRST_CUSTOM, OPT_MODELS_DIR };
 
 typedef struct transfer_options {
-    const char *workspace, *models, *models_dir;
+    const char *workspace, *models, *models_dir, *attack;
     cli_flags flags;
 } transfer_options;
 
@@ -36,6 +38,7 @@ static vf_status parse_options(int argc, char **argv, transfer_options *opt)
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
         CLI_ENGINE_OPTION,
+        CLI_ATTACK_OPTION,
         {"models", required_argument, NULL, OPT_MODELS},
         {"models-dir", required_argument, NULL, OPT_MODELS_DIR},
         {0, 0, 0, 0},
@@ -48,6 +51,8 @@ static vf_status parse_options(int argc, char **argv, transfer_options *opt)
             opt->models = optarg;
         else if (c == OPT_MODELS_DIR)
             opt->models_dir = optarg;
+        else if (c == CLI_OPT_ATTACK)
+            opt->attack = optarg;
     }
     if (optind != argc - 1)
         return vf_fail(VF_EINPUT, "give one workspace folder (see 'vfcapture transfer --help')");
@@ -106,7 +111,7 @@ static vf_status run(const transfer_options *opt)
     for (int m = 0; m < model_count; m++)
         paths[m] = models[m];
     if (s == VF_OK)
-        s = vf_transfer_run(opt->workspace, paths, model_count, &doc);
+        s = vf_transfer_run(opt->workspace, opt->attack, paths, model_count, &doc);
     if (s == VF_OK && opt->flags.json)
         cli_print_json(json_incref(doc));
     else if (s == VF_OK)

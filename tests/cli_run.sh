@@ -13,7 +13,9 @@ budget=(--train-steps 500 --steps 2 --samples 6 --label "folding chair,rocking c
 
 expect 0 "run on the chair" -- "$tool" run "$chair/transforms_train.json" -o "$ws" "${budget[@]}" --json
 json_check "run reports the attack" 'd["attack"]["asr_v_star"] >= 0 and d["shot_card"].endswith("shot_card.png")'
-for f in train/model.vff train/report.json train/held_out.jpg attack/attack.json attack/v_star.png export/targets.json export/shot_card.png; do
+attack=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["attack_name"])' "$tmp/out")
+[ "$attack" = "mobilenet_v2_1.0_224_quant-nes-l0.01-both" ] && ok || bad "run names its attack by model, method, lambda and space: $attack"
+for f in train/model.vff train/report.json train/held_out.jpg "attack/$attack/attack.json" "attack/$attack/v_star.png" export/targets.json export/shot_card.png; do
   [ -s "$ws/$f" ] && ok || bad "run wrote $f"
 done
 python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["held_out_psnr"] > 22, r["held_out_psnr"]' "$ws/train/report.json" \
@@ -92,10 +94,10 @@ cmp -s "$ws/manifest.json" "$tmp/manifest.before" && ok || bad "failed commands 
 # An interrupted attack continues from its checkpoint (the old code never resumed one, and
 # --resume refused every real capture), other settings are refused naming --restart, and
 # --restart says what it discards.
-attack=(attack "$ws" --steps 10 --samples 6 --label "folding chair")
-"$tool" "${attack[@]}" --quiet 2>/dev/null &
+attack_args=(attack "$ws" --steps 10 --samples 6 --label "folding chair")
+"$tool" "${attack_args[@]}" --quiet 2>/dev/null &
 pid=$!
-checkpoint="$ws/.attack.partial/checkpoint.json"
+checkpoint="$ws/attack/.$attack.partial/checkpoint.json"
 for _ in $(seq 600); do
   python3 -c 'import json,sys; sys.exit(0 if json.load(open(sys.argv[1]))["state"]["step"] >= 3 else 1)' "$checkpoint" 2>/dev/null && break
   sleep 0.2
@@ -104,27 +106,50 @@ kill "$pid"; wait "$pid" 2>/dev/null  # TERM: a background job ignores INT
 [ -f "$checkpoint" ] && ok || bad "the interrupted attack left its checkpoint"
 expect 1 "other settings" -- "$tool" attack "$ws" --steps 30 --samples 6 --label "folding chair"
 grep -q -- "--restart" "$tmp/err" && ok || bad "other settings are refused naming --restart: $(tail -1 "$tmp/err")"
-expect 0 "the attack continues" -- "$tool" "${attack[@]}" --json
+expect 0 "the attack continues" -- "$tool" "${attack_args[@]}" --json
 grep -Eq "continuing the interrupted attack at step [3-9] of 10" "$tmp/err" && ok || bad "continued mid-way: $(grep -i continu "$tmp/err")"
 json_check "all 10 steps in the result" 'len(d["loss_per_step"]) == 10'
 [ ! -e "$checkpoint" ] && ok || bad "the checkpoint goes once the attack is committed"
-"$tool" "${attack[@]}" --steps 5 --quiet 2>/dev/null &
+"$tool" "${attack_args[@]}" --steps 5 --quiet 2>/dev/null &
 pid=$!
 for _ in $(seq 600); do [ -f "$checkpoint" ] && break; sleep 0.2; done
 kill "$pid"; wait "$pid" 2>/dev/null  # TERM: a background job ignores INT
-expect 0 "--restart" -- "$tool" "${attack[@]}" --steps 2 --restart
+expect 0 "--restart" -- "$tool" "${attack_args[@]}" --steps 2 --restart
 grep -q "discarding what an interrupted run left" "$tmp/err" && ok || bad "--restart says it discards the checkpoint: $(head -3 "$tmp/err")"
 
 # A checkpoint of an earlier field (trained again since, here touched) is not continued: the
 # search starts over on the new one (the old code continued a scene-mode attack on an
 # object-mode field).
-"$tool" "${attack[@]}" --quiet 2>/dev/null &
+"$tool" "${attack_args[@]}" --quiet 2>/dev/null &
 pid=$!
 for _ in $(seq 600); do [ -f "$checkpoint" ] && break; sleep 0.2; done
 kill "$pid"; wait "$pid" 2>/dev/null  # TERM: a background job ignores INT
 touch -d "+1 minute" "$ws/train/model.vff"
-expect 0 "an earlier field's checkpoint" -- "$tool" "${attack[@]}" --json
+expect 0 "an earlier field's checkpoint" -- "$tool" "${attack_args[@]}" --json
 grep -q "ran on an earlier field: starting over" "$tmp/err" && ok || bad "starts over on a new field: $(grep -i continu "$tmp/err")"
 json_check "all 10 steps in the result" 'len(d["loss_per_step"]) == 10'
+
+# Several attacks side by side on one field: random search next to the NES attack, each under
+# its name; a command that reads an attack asks which when there are several.
+expect 0 "a second attack" -- "$tool" attack "$ws" --method random --samples 6 --label "folding chair" --quiet
+[ -s "$ws/attack/mobilenet_v2_1.0_224_quant-random-both/attack.json" ] && [ -s "$ws/attack/$attack/attack.json" ] \
+  && ok || bad "both attacks kept: $(ls "$ws/attack")"
+expect 1 "export with two attacks" -- "$tool" export "$ws" --quiet
+one_line_naming "export with two attacks" "--attack NAME"
+expect 0 "export of the named attack" -- "$tool" export "$ws" --attack mobilenet_v2_1.0_224_quant-random-both --count 2 --quiet
+python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); assert m["stages"]["export"]["params"]["attack"] == "mobilenet_v2_1.0_224_quant-random-both"' "$ws/manifest.json" \
+  && ok || bad "export records the attack it exported"
+expect 1 "export of an attack not there" -- "$tool" export "$ws" --attack nes-l9 --quiet
+one_line_naming "export of an attack not there" "has no attack 'nes-l9'"
+
+# Another input ingested into the trained workspace: what was built on the old one is stale
+# and refused with one line naming what to rerun (the old code attacked the old field).
+expect 0 "re-ingest another set" -- "$tool" ingest "$chair/transforms_test.json" -o "$ws" --quiet
+expect 1 "attack on a stale field" -- "$tool" attack "$ws" --steps 1 --samples 6 --label "folding chair"
+one_line_naming "attack on a stale field" "train is stale"
+expect 1 "export of a stale attack" -- "$tool" export "$ws" --attack "$attack"
+one_line_naming "export of a stale attack" "stale"
+expect 1 "render of a stale field" -- "$tool" render "$ws" --viewpoint 30,0,60,0,0,0 -o "$tmp/stale.png"
+one_line_naming "render of a stale field" "vfcapture train"
 
 cli_finish

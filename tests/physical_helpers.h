@@ -21,7 +21,7 @@ typedef struct test_label_set {
     const char *names[4];
 } test_label_set;
 
-/* WS/attack/attack.json with v*, the label set, the paper's search box and samples (count
+/* WS/attack/test/attack.json with v*, the label set, the paper's search box and samples (count
  * viewpoints), the default classifier. */
 static inline void write_test_attack(const char *ws, const test_label_set *labels,
                                      const vf_viewpoint *v_star, const vf_viewpoint *samples,
@@ -54,7 +54,7 @@ static inline void write_test_attack(const char *ws, const test_label_set *label
     char path[2 * VF_PATH_MAX];
     vf_workspace w;
     vf_stage stage;
-    CHECK(vf_workspace_open(ws, 0, &w) == VF_OK && vf_stage_begin(&w, "attack", &stage) == VF_OK,
+    CHECK(vf_workspace_open(ws, 0, &w) == VF_OK && vf_stage_begin(&w, "attack/test", &stage) == VF_OK,
           "attack stage begun: %s", vf_error_message());
     snprintf(path, sizeof path, "%s/attack.json", stage.dir);
     CHECK(vf_json_save(path, doc) == VF_OK && vf_stage_commit(&stage, NULL, NULL) == VF_OK,

@@ -123,13 +123,14 @@ int main(void)
           VF_TRAIN_MINUTES_MODEL, minutes);
     json_decref(manifest);
 
-    rc = vf_test_system("'%s' attack '%s' --label 'bell pepper' --steps 5 --samples 10 --quiet && "
+    rc = vf_test_system("'%s' attack '%s' --attack pepper --label 'bell pepper' --steps 5 --samples 10 "
+                        "--quiet && "
                         "'%s' real '%s' --fluctuation-samples 2 --natural-views 20 --quiet",
                         tool(), ws, tool(), ws);
     CHECK(rc == 0, "attack and real (exit %d)", rc);
     if (rc != 0)
         return check_finish();
-    json_t *real = load(ws, "real/real.json");
+    json_t *real = load(ws, "real/pepper/real.json"); /* the only attack, named */
     double nat_field = number(real, "natural_accuracy", "field");
     double nat_real = number(real, "natural_accuracy", "real");
     double agree = number(real, "agreement_natural", NULL);
@@ -169,7 +170,7 @@ int main(void)
           number(row, "real_asr_samples", NULL), number(row, "real_natural_accuracy", NULL));
     json_decref(rows);
     json_decref(real);
-    snprintf(ws, sizeof ws, "%s/ws/real/sheet.png", dir);
+    snprintf(ws, sizeof ws, "%s/ws/real/pepper/sheet.png", dir);
     CHECK(vf_is_file(ws), "the contact sheet %s", ws);
     return check_finish();
 }

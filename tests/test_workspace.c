@@ -117,6 +117,13 @@ static void test_stage_swap(void)
     vf_workspace_path(&ws, "ingest", "a.txt", path, sizeof path);
     CHECK(file_says(path, "first"), "output in place");
     CHECK(!vf_is_dir(stage.dir), "staging folder gone after commit");
+    json_t *mirror = NULL;
+    vf_workspace_path(&ws, "ingest", VF_STAGE_FILE, path, sizeof path);
+    CHECK(vf_json_load(path, &mirror) == VF_OK &&
+              json_equal(mirror, vf_workspace_stage_record(&ws, "ingest")),
+          "the stage folder holds its manifest record");
+    json_decref(mirror);
+    vf_workspace_path(&ws, "ingest", "a.txt", path, sizeof path);
 
     /* A second run that fails: the first output stays. */
     CHECK(vf_stage_begin(&ws, "ingest", &stage) == VF_OK, "begin again");

@@ -4,7 +4,7 @@
  *     vf_attack_defaults(&o);
  *     o.label = "folding chair";
  *     json_t *result;
- *     vf_status s = vf_attack_run(&ws, &o, &result);   // WS/attack/ committed
+ *     vf_status s = vf_attack_run(&ws, &o, &result);   // WS/attack/NAME/ committed
  *
  * The stage: check the model and the label set before anything heavy; load the field
  * (WS/train/model.vff) and the training cameras; classify renders at the training poses
@@ -14,6 +14,12 @@
  * with a checkpoint a step in the staging folder; measure v*, VF_EVAL_SAMPLES samples,
  * fluctuation and the random-search baseline (vf/attack_eval.h); write attack.json
  * (vf/attack_file.h), v_star.png, samples.png, loss.png and fluctuation.png; commit.
+ *
+ * A workspace keeps several attacks side by side, each the stage "attack/NAME" in its own
+ * folder WS/attack/NAME/: the name is given (o.name) or made of the classifier, the method,
+ * lambda and the space (vf_attack_default_name: "mobilenet_v2_1.0_224_quant-nes-l0.01-both").
+ * An attack run again under its name replaces that one alone. Attacks of one workspace may run
+ * at the same time in different processes (vf/workspace.h).
  *
  * Life cycle, as every stage with a checkpoint (train, a model's ingest, real): a failure
  * after the stage began leaves its staging folder and checkpoint, and the next run continues
@@ -57,9 +63,15 @@ typedef struct vf_attack_options {
     const char *bounds;      /* "psi=-90:90,..." applied last (vf_view_bounds_parse), or NULL */
     uint64_t seed;           /* 0: the same seed gives the same result */
     int restart;             /* discard an interrupted attack's checkpoint (see the top) */
+    const char *name;        /* the attack's name; NULL: vf_attack_default_name */
 } vf_attack_options;
 
 void vf_attack_defaults(vf_attack_options *o);
+
+/* The name an attack with these options gets when none is given: the classifier's file name
+ * without .onnx, the method, "l" and lambda (not for random search), the space, and "k" and
+ * the mixture size when above 1, joined by '-', in the characters a stage name takes. */
+void vf_attack_default_name(const vf_attack_options *o, char *out, size_t size);
 
 /* VF_EINPUT naming the option when the options cannot run (a method/components clash). */
 vf_status vf_attack_options_check(const vf_attack_options *o);

@@ -1,4 +1,4 @@
-/* vf/attack_file.h: WS/attack/attack.json, the attack's result, written and read here only.
+/* vf/attack_file.h: WS/attack/NAME/attack.json, an attack's result, written and read here only.
  *
  * The attack stage (vf/attack.h) writes it with vf_attack_file_json; export, reshoot, score,
  * transfer, real and the ImageNet-V style set read it with vf_attack_file_load. Keys (all
@@ -44,7 +44,7 @@
 extern "C" {
 #endif
 
-#define VF_ATTACK_FILE "attack.json" /* in the stage folder WS/attack/ */
+#define VF_ATTACK_FILE "attack.json" /* in the stage folder WS/attack/NAME/ */
 
 /* ---- writing ---- */
 
@@ -78,6 +78,7 @@ typedef struct vf_sample_prediction {
 } vf_sample_prediction;
 
 typedef struct vf_attack_file {
+    char stage[128];         /* "attack/NAME" (vf_attack_file_load_workspace; "" otherwise) */
     char model[VF_PATH_MAX]; /* classifier the attack used ("" when not given) */
     char method[16];         /* nes, pepg, random ("" when not given) */
     int label_count;
@@ -107,9 +108,13 @@ typedef struct vf_attack_file {
 vf_status vf_attack_file_load(const char *path, vf_attack_file *out);
 void vf_attack_file_free(vf_attack_file *a);
 
-/* WS/attack/attack.json of a workspace: VF_EINPUT saying to run the attack first when the
- * stage is not there. */
-vf_status vf_attack_file_load_workspace(const vf_workspace *ws, vf_attack_file *out);
+/* Which attack a command uses: "attack/NAME" when name is given, else the workspace's only
+ * attack, into stage. VF_EINPUT, one line, when there is none, when the named one is not
+ * there (naming those that are), when several are and none is named, or when it is stale. */
+vf_status vf_attack_choose(const vf_workspace *ws, const char *name, char *stage, size_t size);
+/* The chosen attack's attack.json (vf_attack_choose); out->stage names it. */
+vf_status vf_attack_file_load_workspace(const vf_workspace *ws, const char *name,
+                                        vf_attack_file *out);
 
 /* Whether class `cls` belongs to the attack's label set. */
 int vf_attack_is_label(const vf_attack_file *a, int cls);

@@ -25,7 +25,8 @@ extern "C" {
 #define VF_EXPORT_MAX_COUNT 1000
 
 typedef struct vf_export_options {
-    int count; /* samples of p*(v) besides v*, 0..VF_EXPORT_MAX_COUNT (8) */
+    const char *attack; /* the attack exported (vf_attack_choose); NULL: the only one */
+    int count;          /* samples of p*(v) besides v*, 0..VF_EXPORT_MAX_COUNT (8) */
 } vf_export_options;
 
 void vf_export_defaults(vf_export_options *o);
@@ -33,6 +34,10 @@ void vf_export_defaults(vf_export_options *o);
 /* Run the stage on an open workspace that has an attack. *result (may be NULL) gets
  * targets.json's document (a new reference). */
 vf_status vf_export_run(vf_workspace *ws, const vf_export_options *o, json_t **result);
+
+/* The name of the attack the workspace's export used (a borrowed string), or NULL when there
+ * is no export: the physical loop (reshoot, score, the studio) follows that attack. */
+const char *vf_export_attack(const vf_workspace *ws);
 
 #ifdef __cplusplus
 }

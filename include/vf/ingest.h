@@ -93,6 +93,13 @@ const char *vf_ingest_kind_name(vf_ingest_kind kind);
  * model, any other file a video. VF_EINPUT when the path does not exist. */
 vf_status vf_ingest_input_kind(const char *path, vf_ingest_kind *kind);
 
+/* An input by content, so a workspace knows when it was made from another one (a path
+ * says nothing: the same name may hold a new video): *identity (a new reference) gets
+ * {"bytes", "files", "mtime", "hash"}, the hash over the file's bytes, or over a folder's
+ * files (names and bytes, in name order). A posed set is its transforms file alone. The
+ * ingest stage records it in its params as "input_identity"; run compares by it. */
+vf_status vf_ingest_input_identity(const char *path, json_t **identity);
+
 typedef struct vf_ingest_request {
     vf_ingest_kind kind;
     const char *input;         /* the file, folder or device */

@@ -8,8 +8,8 @@
  *
  * Calls each stage's library function in turn: ingest, poses (not for a 3D model; for a posed
  * set only when its photos have a background, and then it keeps the set's poses and only
- * triangulates points), train, attack, real (a 3D model only: the attack's viewpoints on the object itself)
- * and export. WS/run.json remembers, per stage, the settings it ran with and the completion
+ * triangulates points), train, attack, real (a 3D model only: the attack's viewpoints on the
+ * object itself) and export. WS/run.json remembers, per stage, the settings it ran with and the completion
  * stamp the manifest gave it; a stage is redone when its output is missing, its settings
  * changed, it was re-run by hand since, or a stage before it was redone (or `restart`). Each
  * stage resumes an interrupted run of its own as it does when called alone. */
@@ -44,8 +44,9 @@ typedef struct vf_run_options {
 void vf_run_defaults(vf_run_options *o);
 
 /* Run the stages into the workspace at ws_root (created when missing). *summary (a new
- * reference) gets {workspace, seconds, attack (the attack stage's summary), shot_card,
- * attack_report}. A failing stage's message says which ("stage poses: ..."); the stages before
+ * reference) gets {workspace, seconds, attack_name, attack (the attack stage's summary),
+ * shot_card, attack_report}. The attack is the stage "attack/NAME" (o->attack.name, or
+ * vf_attack_default_name); real and export use that one. A failing stage's message says which ("stage poses: ..."); the stages before
  * it stay done for the next run. */
 vf_status vf_run(const char *ws_root, const vf_run_options *o, json_t **summary);
 

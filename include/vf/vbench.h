@@ -31,6 +31,7 @@ typedef enum { VF_VBENCH_NATURAL = 0, VF_VBENCH_ADVERSARIAL = 1 } vf_vbench_spli
 typedef struct vf_vbench_build_options {
     int count;     /* images per object and split (default 100) */
     uint64_t seed; /* sampling seed (default 0) */
+    const char *attack; /* each workspace's attack of this name; NULL: its only one */
 } vf_vbench_build_options;
 
 /* Render the set for n workspaces into out_dir (created; must not hold a set already unless

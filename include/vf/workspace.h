@@ -2,7 +2,9 @@
  *
  *   WS/manifest.json   which stages ran, when, with which parameters and tool version
  *   WS/ingest/ ...     each stage writes only its own folder
- *   WS/FAMILY/NAME/    a stage with a name ("reshoot/t00"): one of several of its family
+ *   WS/FAMILY/NAME/    a stage with a name ("attack/nes-l0.01"): one of several of its family
+ *   WS/<stage>/stage.json   that stage's manifest record, written with it (for workflow
+ *                      engines such as Snakemake, which watch files: the manifest is the truth)
  *
  * A stage never writes its folder in place. vf_stage_begin() gives it an empty staging folder
  * (WS/.<stage>.partial, WS/FAMILY/.NAME.partial); vf_stage_commit() swaps that folder in and
@@ -37,6 +39,8 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+#define VF_STAGE_FILE "stage.json" /* in each committed stage's folder: its record */
 
 typedef struct vf_workspace {
     char root[VF_PATH_MAX];
@@ -73,6 +77,10 @@ vf_status vf_workspace_need(const vf_workspace *ws, const char *stage);
 int vf_workspace_is_stale(const vf_workspace *ws, const char *stage, char *why, size_t size);
 /* Read the manifest again from disk (what other processes committed since it was opened). */
 vf_status vf_workspace_reload(vf_workspace *ws);
+/* The names of the completed stages of a family ("attack" -> "attack/a", "attack/b"), in the
+ * manifest's order, as borrowed strings into names (at most max); returns how many. */
+int vf_workspace_stages_of(const vf_workspace *ws, const char *family, const char **names,
+                           int max);
 /* The manifest record of a completed stage ({"params":..., "summary":...}), or NULL. Borrowed. */
 json_t *vf_workspace_stage_record(const vf_workspace *ws, const char *stage);
 /* WS/<stage>/<file> into out (file may be "" for the folder itself). */

@@ -330,15 +330,51 @@ vf_status vf_attack_file_load(const char *path, vf_attack_file *out)
     return status;
 }
 
-vf_status vf_attack_file_load_workspace(const vf_workspace *ws, vf_attack_file *out)
+/* "a, b, c" of the workspace's attack names. */
+static void list_attacks(const char *const *stages, int n, char *out, size_t size)
 {
-    char path[VF_PATH_MAX];
-    memset(out, 0, sizeof *out);
-    if (!vf_workspace_has_stage(ws, "attack"))
+    size_t used = 0;
+    out[0] = '\0';
+    for (int i = 0; i < n && used < size; i++)
+        used += (size_t)snprintf(out + used, size - used, "%s%s", i ? ", " : "", stages[i] + 7);
+}
+
+vf_status vf_attack_choose(const vf_workspace *ws, const char *name, char *stage, size_t size)
+{
+    const char *stages[64];
+    char names[1024];
+    int n = vf_workspace_stages_of(ws, "attack", stages, 64);
+    list_attacks(stages, n, names, sizeof names);
+    if (name && name[0]) {
+        if ((size_t)snprintf(stage, size, "attack/%s", name) >= size)
+            return vf_fail(VF_EINPUT, "attack name too long: %s", name);
+        if (!vf_workspace_has_stage(ws, stage) && n > 0)
+            return vf_fail(VF_EINPUT, "%s has no attack '%s' (it has %s)", ws->root, name, names);
+    } else if (n == 1) {
+        snprintf(stage, size, "%s", stages[0]);
+    } else if (n > 1) {
+        return vf_fail(VF_EINPUT, "%s has %d attacks (%s): choose one with --attack NAME",
+                       ws->root, n, names);
+    } else {
         return vf_fail(VF_EINPUT, "%s has no attack yet: run 'vfcapture attack %s' first",
                        ws->root, ws->root);
-    vf_status s = vf_workspace_path(ws, "attack", VF_ATTACK_FILE, path, sizeof path);
-    return s == VF_OK ? vf_attack_file_load(path, out) : s;
+    }
+    return vf_workspace_need(ws, stage);
+}
+
+vf_status vf_attack_file_load_workspace(const vf_workspace *ws, const char *name,
+                                        vf_attack_file *out)
+{
+    char path[VF_PATH_MAX], stage[128];
+    memset(out, 0, sizeof *out);
+    vf_status s = vf_attack_choose(ws, name, stage, sizeof stage);
+    if (s == VF_OK)
+        s = vf_workspace_path(ws, stage, VF_ATTACK_FILE, path, sizeof path);
+    if (s == VF_OK)
+        s = vf_attack_file_load(path, out);
+    if (s == VF_OK)
+        snprintf(out->stage, sizeof out->stage, "%s", stage);
+    return s;
 }
 
 void vf_attack_file_free(vf_attack_file *a)

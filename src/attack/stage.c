@@ -2,6 +2,7 @@
 #define _GNU_SOURCE /* struct stat's st_mtim */
 #include "vf/attack.h"
 
+#include <ctype.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -47,6 +48,25 @@ void vf_attack_defaults(vf_attack_options *o)
                              .space = VF_SPACE_BOTH};
 }
 
+void vf_attack_default_name(const vf_attack_options *o, char *out, size_t size)
+{
+    char model[256], lambda[32] = "";
+    vf_path_basename(model, sizeof model, o->model ? o->model : VF_DEFAULT_MODEL, 0);
+    size_t len = strlen(model);
+    if (len > 5 && !strcmp(model + len - 5, ".onnx"))
+        model[len - 5] = '\0';
+    for (char *c = model; *c; c++) /* a stage name's characters */
+        *c = isalnum((unsigned char)*c) || *c == '.' || *c == '-' ? (char)tolower(*c) : '_';
+    if (!isalnum((unsigned char)model[0]))
+        model[0] = 'm';
+    if (o->method != VF_SEARCH_RANDOM)
+        snprintf(lambda, sizeof lambda, "-l%g", o->lambda >= 0 ? o->lambda : 0.01);
+    int n = snprintf(out, size, "%s-%s%s-%s", model, vf_attack_search_name(o->method), lambda,
+                     vf_view_space_name(o->space));
+    if (o->components > 1 && n >= 0 && (size_t)n < size)
+        snprintf(out + n, size - (size_t)n, "-k%d", o->components);
+}
+
 vf_status vf_attack_options_check(const vf_attack_options *o)
 {
     if ((unsigned)o->method > VF_SEARCH_RANDOM)
@@ -56,6 +76,12 @@ vf_status vf_attack_options_check(const vf_attack_options *o)
                        VF_ATTACK_MAX_COMPONENTS, o->components);
     if (o->components > 1 && o->method != VF_SEARCH_NES)
         return vf_fail(VF_EINPUT, "a mixture of components needs the nes method");
+    char stage[160];
+    snprintf(stage, sizeof stage, "attack/%s", o->name ? o->name : "x");
+    if (o->name && vf_stage_name_check(stage) != VF_OK)
+        return vf_fail(VF_EINPUT, "'%s' is not an attack name: use lower-case letters, digits, "
+                                  "'_', '-' and '.'",
+                       o->name);
     return VF_OK;
 }
 
@@ -63,6 +89,7 @@ vf_status vf_attack_options_check(const vf_attack_options *o)
 typedef struct attack_run {
     const vf_attack_options *opt;
     vf_workspace *ws;
+    char stage_name[160]; /* attack/NAME */
     char model_path[VF_PATH_MAX];
     int labels[VF_MAX_LABELS], label_count, label_proposed;
     vf_field *field;
@@ -364,8 +391,8 @@ static vf_status attack_and_report(attack_run *run, json_t **result)
     vf_random_search_result baseline;
     vf_status s = ev ? VF_OK : vf_fail(VF_EINTERNAL, "out of memory");
     if (s == VF_OK)
-        s = run->opt->restart ? vf_stage_begin(run->ws, "attack", &run->stage)
-                              : vf_stage_resume(run->ws, "attack", &run->stage);
+        s = run->opt->restart ? vf_stage_begin(run->ws, run->stage_name, &run->stage)
+                              : vf_stage_resume(run->ws, run->stage_name, &run->stage);
     if (s == VF_OK && !random)
         s = optimize(run, &st);
     double t0 = vf_now();
@@ -394,7 +421,8 @@ static vf_status attack_and_report(attack_run *run, json_t **result)
         s = vf_json_save(path, doc);
     if (s == VF_OK) {
         json_t *params =
-            json_pack("{s:s, s:s, s:O, s:O}", "method", vf_attack_search_name(run->opt->method),
+            json_pack("{s:s, s:s, s:s, s:O, s:O}", "name", run->stage_name + 7, "method",
+                      vf_attack_search_name(run->opt->method),
                       "space", vf_view_space_name(run->opt->space), "config",
                       json_object_get(doc, "config"), "label", json_object_get(doc, "label"));
         json_t *summary = json_pack("{s:f, s:f, s:f}", "natural_accuracy", run->natural_accuracy,
@@ -402,7 +430,8 @@ static vf_status attack_and_report(attack_run *run, json_t **result)
         s = vf_stage_commit(&run->stage, params, summary);
     }
     /* the checkpoint goes once the stage is in place (a failed commit keeps it for resume) */
-    if (s == VF_OK && vf_workspace_path(run->ws, "attack", CHECKPOINT, path, sizeof path) == VF_OK)
+    if (s == VF_OK &&
+        vf_workspace_path(run->ws, run->stage_name, CHECKPOINT, path, sizeof path) == VF_OK)
         remove(path);
     if (s == VF_OK && result)
         *result = json_incref(doc);
@@ -418,8 +447,17 @@ vf_status vf_attack_run(vf_workspace *ws, const vf_attack_options *o, json_t **r
     if (result)
         *result = NULL;
     vf_status s = check_inputs(&run);
-    if (s == VF_OK)
+    if (s == VF_OK) {
+        char name[128];
+        if (o->name)
+            snprintf(name, sizeof name, "%s", o->name);
+        else
+            vf_attack_default_name(o, name, sizeof name);
+        snprintf(run.stage_name, sizeof run.stage_name, "attack/%s", name);
         s = vf_field_load_workspace(ws, &run.field);
+        if (s == VF_OK)
+            vf_info("attack %s, kept in %s/%s/", name, ws->root, run.stage_name);
+    }
     if (s == VF_OK)
         s = load_cameras(&run);
     if (s == VF_OK)

@@ -59,9 +59,10 @@ static vf_status measure_model(const char *model, const vf_field *field, const d
     return s;
 }
 
-vf_status vf_transfer_run(const char *ws_root, char *const *models, int model_count,
-                          json_t **result)
+vf_status vf_transfer_run(const char *ws_root, const char *attack, char *const *models,
+                          int model_count, json_t **result)
 {
+    char stage_name[160];
     *result = NULL;
     vf_workspace ws = {0};
     vf_field *field = NULL;
@@ -77,10 +78,13 @@ vf_status vf_transfer_run(const char *ws_root, char *const *models, int model_co
     if (s == VF_OK)
         s = vf_field_load_workspace(&ws, &field);
     if (s == VF_OK)
-        s = vf_attack_file_load_workspace(&ws, &r);
+        s = vf_attack_file_load_workspace(&ws, attack, &r);
     if (s == VF_OK && r.sample_count < 1)
-        s = vf_fail(VF_EINPUT, "%s/attack/attack.json has no samples: run the attack again",
-                    ws.root);
+        s = vf_fail(VF_EINPUT, "%s/%s/attack.json has no samples: run the attack again",
+                    ws.root, r.stage);
+    if (s == VF_OK && snprintf(stage_name, sizeof stage_name, "transfer/%s", r.stage + 7) >=
+                          (int)sizeof stage_name)
+        s = vf_fail(VF_EINPUT, "attack name too long: %s", r.stage);
     if (s == VF_OK && (s = vf_dataset_load_training(&ws, &natural, NULL)) == VF_OK &&
         !(c2w = vf_dataset_poses(&natural)))
         s = vf_fail(VF_EINTERNAL, "out of memory");
@@ -97,7 +101,7 @@ vf_status vf_transfer_run(const char *ws_root, char *const *models, int model_co
         vf_progress_end(&progress);
     char path[VF_PATH_MAX];
     json_t *doc = NULL;
-    if (s == VF_OK && (s = vf_stage_begin(&ws, "transfer", &stage)) == VF_OK) {
+    if (s == VF_OK && (s = vf_stage_begin(&ws, stage_name, &stage)) == VF_OK) {
         doc = json_pack("{s:s, s:O, s:i, s:O}", "attack_model", r.model, "label", r.label,
                         "samples", r.sample_count, "models", rows);
         s = vf_path_join(path, sizeof path, stage.dir, "transfer.json");
@@ -107,7 +111,8 @@ vf_status vf_transfer_run(const char *ws_root, char *const *models, int model_co
         for (int m = 0; m < model_count; m++)
             json_array_append_new(names, json_string(models[m]));
         if (s == VF_OK) {
-            s = vf_stage_commit(&stage, json_pack("{s:o}", "models", names), NULL);
+            s = vf_stage_commit(&stage, json_pack("{s:s, s:o}", "attack", r.stage + 7, "models", names),
+                                NULL);
         } else {
             json_decref(names);
             vf_stage_abort(&stage);

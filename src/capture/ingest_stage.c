@@ -239,8 +239,14 @@ static vf_status run_in_stage(const char *root, const vf_ingest_request *opt, im
     int resumable = import == import_model;
     status =
         resumable ? vf_stage_resume(&ws, "ingest", &stage) : vf_stage_begin(&ws, "ingest", &stage);
+    json_t *identity = NULL; /* read before the import: it is what the import read */
+    if (status == VF_OK && opt->kind != VF_INGEST_CAMERA)
+        status = vf_ingest_input_identity(opt->input, &identity);
     if (status == VF_OK)
         status = import(opt, stage.dir, &params, &summary);
+    if (status == VF_OK && identity)
+        json_object_set(params, "input_identity", identity);
+    json_decref(identity);
     char first[VF_PATH_MAX]; /* renders made so far stay for a retry */
     int keep = resumable && status == VF_EINTERNAL &&
                vf_path_join(first, sizeof first, stage.dir, "images/r_000.png") == VF_OK &&

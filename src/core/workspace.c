@@ -291,6 +291,21 @@ int vf_workspace_has_stage(const vf_workspace *ws, const char *stage)
            vf_workspace_path(ws, stage, "", dir, sizeof dir) == VF_OK && vf_is_dir(dir);
 }
 
+int vf_workspace_stages_of(const vf_workspace *ws, const char *family, const char **names,
+                           int max)
+{
+    const char *key;
+    json_t *record;
+    size_t len = strlen(family);
+    int n = 0;
+    json_object_foreach(stages_of(ws), key, record) {
+        if (n < max && !strncmp(key, family, len) && key[len] == '/' &&
+            vf_workspace_has_stage(ws, key))
+            names[n++] = key;
+    }
+    return n;
+}
+
 vf_status vf_workspace_path(const vf_workspace *ws, const char *stage, const char *file, char *out,
                             size_t size)
 {
@@ -470,13 +485,30 @@ static vf_status record_stage(vf_workspace *ws, const char *stage, json_t *recor
 
 vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary)
 {
-    char final_dir[VF_PATH_MAX], old_dir[VF_PATH_MAX], when[32], id[24];
+    char final_dir[VF_PATH_MAX], old_dir[VF_PATH_MAX], stage_file[VF_PATH_MAX], when[32], id[24];
     vf_workspace *ws = s->ws;
-    vf_status status = hidden_path(ws, s->name, ".old", old_dir, sizeof old_dir);
+    utc_timestamp(when, sizeof when);
+    new_id(id, sizeof id);
+    json_t *built_on = json_object();
+    for (int i = 0; i < s->uses; i++)
+        json_object_set_new(built_on, s->used[i], json_string(s->used_id[i]));
+    json_t *record = json_pack("{s:s, s:s, s:s, s:f, s:o, s:o, s:o}", "completed", when, "id", id,
+                               "version", VF_VERSION, "seconds", vf_now() - s->start_time,
+                               "built_on", built_on, "params", params ? params : json_object(),
+                               "summary", summary ? summary : json_object());
+    vf_status status =
+        record ? VF_OK : vf_fail(VF_EINTERNAL, "cannot record %s in the manifest", s->name);
+    if (status == VF_OK)
+        status = hidden_path(ws, s->name, ".old", old_dir, sizeof old_dir);
     if (status == VF_OK)
         status = vf_workspace_path(ws, s->name, "", final_dir, sizeof final_dir);
     if (status == VF_OK)
         status = vf_remove_tree(old_dir);
+    /* The folder describes itself: WS/<stage>/stage.json is its record (what a workflow
+     * engine watches; the manifest stays the reference). */
+    if (status == VF_OK && (status = vf_path_join(stage_file, sizeof stage_file, s->dir,
+                                                  VF_STAGE_FILE)) == VF_OK)
+        status = vf_json_save(stage_file, record);
     if (status != VF_OK)
         goto fail;
 
@@ -496,18 +528,7 @@ vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary)
         goto fail;
     }
 
-    utc_timestamp(when, sizeof when);
-    new_id(id, sizeof id);
-    json_t *built_on = json_object();
-    for (int i = 0; i < s->uses; i++)
-        json_object_set_new(built_on, s->used[i], json_string(s->used_id[i]));
-    json_t *record = json_pack("{s:s, s:s, s:s, s:f, s:o, s:o, s:o}", "completed", when, "id", id,
-                               "version", VF_VERSION, "seconds", vf_now() - s->start_time,
-                               "built_on", built_on, "params", params ? params : json_object(),
-                               "summary", summary ? summary : json_object());
-    params = summary = NULL;
-    status = record ? record_stage(ws, s->name, record)
-                    : vf_fail(VF_EINTERNAL, "cannot record %s in the manifest", s->name);
+    status = record_stage(ws, s->name, record);
     if (status != VF_OK) {
         /* The manifest must describe what is on disk: the new output back to staging, the old
          * folder back in place. */
@@ -524,8 +545,7 @@ vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary)
     return status;
 
 fail:
-    json_decref(params);
-    json_decref(summary);
+    json_decref(record);
     return status;
 }
 

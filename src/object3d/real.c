@@ -20,7 +20,6 @@
 #include "vf/rng.h"
 #include "vf/view_loss.h"
 
-#define STAGE "real"
 #define SHEET_SAMPLES 11 /* v* and this many samples, field beside model, on the sheet */
 #define SHEET_COLUMNS 6
 
@@ -46,6 +45,7 @@ typedef struct real_run {
     vf_image *images;          /* the model's renders */
     int images_loaded;
     vf_stage stage;
+    char stage_name[160]; /* real/NAME */
     double seconds_render, seconds_classify;
 } real_run;
 
@@ -62,7 +62,9 @@ static vf_status open_inputs(real_run *r)
     else
         s = vf_object3d_load(r->ws, &r->obj);
     if (s == VF_OK)
-        s = vf_attack_file_load_workspace(r->ws, &r->af);
+        s = vf_attack_file_load_workspace(r->ws, r->o->attack, &r->af);
+    if (s == VF_OK) /* real/NAME of attack/NAME */
+        snprintf(r->stage_name, sizeof r->stage_name, "real/%s", r->af.stage + 7);
     if (s == VF_OK)
         s = vf_field_load_workspace(r->ws, &r->field);
     const char *name = r->o->classifier       ? r->o->classifier
@@ -365,7 +367,7 @@ vf_status vf_real_run(vf_workspace *ws, const vf_real_options *o, json_t **resul
     if (s == VF_OK)
         s = make_cameras(&r);
     int staged = 0;
-    if (s == VF_OK && (s = vf_stage_resume(ws, STAGE, &r.stage)) == VF_OK)
+    if (s == VF_OK && (s = vf_stage_resume(ws, r.stage_name, &r.stage)) == VF_OK)
         staged = 1;
     if (s == VF_OK) {
         vf_info("checking %d cameras on the field and on %s", r.n, r.obj.model);
@@ -380,7 +382,8 @@ vf_status vf_real_run(vf_workspace *ws, const vf_real_options *o, json_t **resul
                                 json_object_get(doc, "asr_samples"), "natural_accuracy",
                                 json_object_get(doc, "natural_accuracy"), "agreement",
                                 json_object_get(doc, "agreement"), "cameras", r.n);
-        json_t *params = json_pack("{s:s, s:i, s:i, s:I}", "classifier", r.classifier_path,
+        json_t *params = json_pack("{s:s, s:s, s:i, s:i, s:I}", "attack", r.af.stage + 7,
+                                   "classifier", r.classifier_path,
                                    "fluctuation_samples", o->fluctuation_samples,
                                    "natural_views", o->natural_views, "seed",
                                    (json_int_t)o->seed);
@@ -395,14 +398,18 @@ vf_status vf_real_run(vf_workspace *ws, const vf_real_options *o, json_t **resul
     return s;
 }
 
-vf_status vf_real_load_rates(const vf_workspace *ws, vf_real_rates *out, int *found)
+vf_status vf_real_load_rates(const vf_workspace *ws, const char *attack, vf_real_rates *out,
+                             int *found)
 {
-    char path[VF_PATH_MAX];
+    char path[VF_PATH_MAX], stage[160];
     json_t *doc = NULL;
     *found = 0;
-    if (!vf_workspace_has_stage(ws, "real"))
+    snprintf(stage, sizeof stage, "real/%s", strncmp(attack, "attack/", 7) ? attack : attack + 7);
+    if (!vf_workspace_has_stage(ws, stage))
         return VF_OK;
-    vf_status s = vf_workspace_path(ws, "real", VF_REAL_FILE, path, sizeof path);
+    vf_status s = vf_workspace_need(ws, stage);
+    if (s == VF_OK)
+        s = vf_workspace_path(ws, stage, VF_REAL_FILE, path, sizeof path);
     if (s == VF_OK)
         s = vf_json_load(path, &doc);
     if (s != VF_OK)

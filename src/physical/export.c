@@ -42,10 +42,10 @@ typedef struct export_run {
     int target_count;
 } export_run;
 
-static vf_status load_inputs(export_run *run, const vf_workspace *ws)
+static vf_status load_inputs(export_run *run, const vf_workspace *ws, const char *attack)
 {
     char path[VF_PATH_MAX];
-    vf_status status = vf_attack_file_load_workspace(ws, &run->attack);
+    vf_status status = vf_attack_file_load_workspace(ws, attack, &run->attack);
     if (status == VF_OK)
         status = vf_workspace_path(ws, "poses", VF_NORMALIZATION_FILE, path, sizeof path);
     if (status == VF_OK && vf_is_file(path)) {
@@ -338,6 +338,12 @@ static void export_free(export_run *run)
 
 void vf_export_defaults(vf_export_options *o) { *o = (vf_export_options){.count = 8}; }
 
+const char *vf_export_attack(const vf_workspace *ws)
+{
+    const json_t *params = json_object_get(vf_workspace_stage_record(ws, "export"), "params");
+    return json_string_value(json_object_get(params, "attack"));
+}
+
 vf_status vf_export_run(vf_workspace *ws, const vf_export_options *o, json_t **result)
 {
     export_run run = {.ws = ws->root, .count = o->count};
@@ -349,12 +355,16 @@ vf_status vf_export_run(vf_workspace *ws, const vf_export_options *o, json_t **r
         o->count >= 0 && o->count <= VF_EXPORT_MAX_COUNT
             ? VF_OK
             : vf_fail(VF_EINPUT, "export 0 to %d samples, not %d", VF_EXPORT_MAX_COUNT, o->count);
-    if (status == VF_OK && (status = load_inputs(&run, ws)) == VF_OK &&
+    if (status == VF_OK && (status = load_inputs(&run, ws, o->attack)) == VF_OK &&
         (status = choose_targets(&run)) == VF_OK &&
         (status = vf_stage_begin(ws, "export", &stage)) == VF_OK) {
-        status = write_outputs(&run, stage.dir, &summary, &targets);
+        status = vf_stage_uses(&stage, run.attack.stage);
         if (status == VF_OK)
-            status = vf_stage_commit(&stage, json_pack("{s:i}", "count", run.count),
+            status = write_outputs(&run, stage.dir, &summary, &targets);
+        if (status == VF_OK)
+            status = vf_stage_commit(&stage,
+                                     json_pack("{s:s, s:i}", "attack", run.attack.stage + 7,
+                                               "count", run.count),
                                      json_incref(summary));
         else
             vf_stage_abort(&stage);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "vf/attack_file.h"
+#include "vf/export.h"
 #include "vf/calib.h"
 #include "vf/frames.h"
 #include "vf/log.h"
@@ -148,7 +149,7 @@ static vf_status capture(reshoot_run *run)
 static vf_status reshoot(const vf_reshoot_options *o, vf_workspace *ws, reshoot_run *run)
 {
     char path[VF_PATH_MAX], stage_name[32];
-    vf_status status = vf_attack_file_load_workspace(ws, &run->attack);
+    vf_status status = vf_attack_file_load_workspace(ws, vf_export_attack(ws), &run->attack);
     if (status == VF_OK)
         status = vf_targets_workspace_target(ws->root, o->target, &run->target_v, run->target_c2w);
     if (status == VF_OK)

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "vf/attack_file.h"
+#include "vf/export.h"
 #include "vf/classifier.h"
 #include "vf/field.h"
 #include "vf/frames.h"
@@ -389,7 +390,7 @@ vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
         status =
             vf_fail(VF_EINPUT, "the tolerance must be a share in (0, 1], not %g", o->tolerance);
     if (status == VF_OK)
-        status = vf_attack_file_load_workspace(ws, &run.attack);
+        status = vf_attack_file_load_workspace(ws, vf_export_attack(ws), &run.attack);
     run.center = run.attack.v_star;
     snprintf(run.center_name, sizeof run.center_name, "v*");
     if (status == VF_OK && o->target >= 0) {
@@ -442,9 +443,9 @@ static vf_status summary_row(const char *root, json_t *rows)
     vf_status status = vf_workspace_open(root, 0, &ws);
     if (status != VF_OK)
         return status;
-    status = vf_attack_file_load_workspace(&ws, &a);
+    status = vf_attack_file_load_workspace(&ws, vf_export_attack(&ws), &a);
     if (status == VF_OK)
-        status = vf_real_load_rates(&ws, &real, &has_real);
+        status = vf_real_load_rates(&ws, a.stage, &real, &has_real);
     if (status == VF_OK && vf_workspace_has_stage(&ws, "score") &&
         (status = vf_workspace_path(&ws, "score", "score.json", path, sizeof path)) == VF_OK)
         status = vf_json_load(path, &score);

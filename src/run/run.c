@@ -60,8 +60,20 @@ static const char *skip_poses_of_set(const vf_workspace *ws)
 
 static json_t *text_or_null(const char *text) { return text ? json_string(text) : json_null(); }
 
+/* The input by content (a camera: its device path): the same path holding another video, or
+ * the same video under another name, is told apart. */
+static json_t *input_identity(const vf_ingest_request *in)
+{
+    json_t *identity = NULL;
+    if (in->kind == VF_INGEST_CAMERA || vf_ingest_input_identity(in->input, &identity) != VF_OK)
+        return json_string(in->input); /* an unreadable input fails in ingest itself */
+    json_object_del(identity, "mtime"); /* a copy or a touch is the same input */
+    return identity;
+}
+
 /* The stages this input needs, each with the settings that make its output what it is. */
-static int plan_stages(const vf_run_options *o, stage_call *calls)
+static int plan_stages(const vf_run_options *o, const char *attack_stage, const char *real_stage,
+                       stage_call *calls)
 {
     const vf_ingest_kind kind = o->ingest.kind;
     const vf_ingest_options *cap = &o->ingest.capture;
@@ -69,7 +81,7 @@ static int plan_stages(const vf_run_options *o, stage_call *calls)
     calls[n++] = (stage_call){
         .name = "ingest",
         .which = INGEST,
-        .settings = json_pack("{s:s, s:s, s:i}", "input", o->ingest.input, "kind",
+        .settings = json_pack("{s:o, s:s, s:i}", "input", input_identity(&o->ingest), "kind",
                               vf_ingest_kind_name(kind), "frames", cap->select.max_frames)};
     if (kind != VF_INGEST_MODEL) /* a posed set: its poses kept, points triangulated */
         calls[n++] = (stage_call){.name = "poses",
@@ -87,13 +99,13 @@ static int plan_stages(const vf_run_options *o, stage_call *calls)
     if (o->train.appearance)
         json_object_set_new(calls[n - 1].settings, "appearance", json_true());
     calls[n++] = (stage_call){
-        .name = "attack",
+        .name = attack_stage,
         .which = ATTACK,
         .settings = json_pack("{s:s, s:o, s:i, s:i}", "model", o->attack.model, "label",
                               text_or_null(o->attack.label), "samples", o->attack.samples,
                               "steps", o->attack.steps)};
     if (kind == VF_INGEST_MODEL) /* posed by Blender; the attack checked on the object */
-        calls[n++] = (stage_call){.name = "real", .which = REAL, .settings = json_object()};
+        calls[n++] = (stage_call){.name = real_stage, .which = REAL, .settings = json_object()};
     calls[n++] = (stage_call){.name = "export", .which = EXPORT, .settings = json_object()};
     return n;
 }
@@ -103,12 +115,14 @@ static const char *completed_stamp(const vf_workspace *ws, const char *stage)
     return json_string_value(json_object_get(vf_workspace_stage_record(ws, stage), "completed"));
 }
 
-/* Whether a stage's output is there, made by run with these settings, and not redone since. */
+/* Whether a stage's output is there, made by run with these settings, not redone since, and
+ * not stale (nothing it was built on rerun by hand). */
 static int stage_is_current(const vf_workspace *ws, const json_t *memory, const stage_call *call)
 {
     const json_t *last = json_object_get(memory, call->name);
     const char *stamp = completed_stamp(ws, call->name);
-    return stamp && last && json_equal(json_object_get(last, "settings"), call->settings) &&
+    return stamp && last && !vf_workspace_is_stale(ws, call->name, NULL, 0) &&
+           json_equal(json_object_get(last, "settings"), call->settings) &&
            !strcmp(stamp, json_string_value(json_object_get(last, "completed")) ?: "");
 }
 
@@ -150,15 +164,27 @@ static vf_status run_stages(const char *root, vf_workspace *ws, const vf_run_opt
     return s;
 }
 
-vf_status vf_run(const char *ws_root, const vf_run_options *o, json_t **summary)
+vf_status vf_run(const char *ws_root, const vf_run_options *options, json_t **summary)
 {
     *summary = NULL;
+    /* The attack is kept under its name (vf/attack.h); real and export read that one. */
+    vf_run_options o = *options;
+    char name[128], attack_stage[160], real_stage[160];
+    if (o.attack.name)
+        snprintf(name, sizeof name, "%s", o.attack.name);
+    else
+        vf_attack_default_name(&o.attack, name, sizeof name);
+    o.attack.name = o.real.attack = o.export_.attack = name;
+    snprintf(attack_stage, sizeof attack_stage, "attack/%s", name);
+    snprintf(real_stage, sizeof real_stage, "real/%s", name);
     stage_call calls[6];
-    int count = plan_stages(o, calls);
+    int count = plan_stages(&o, attack_stage, real_stage, calls);
     char memory_path[VF_PATH_MAX];
     vf_workspace ws = {0};
     json_t *memory = NULL;
-    vf_status s = vf_workspace_open(ws_root, 1, &ws);
+    vf_status s = vf_attack_options_check(&o.attack);
+    if (s == VF_OK)
+        s = vf_workspace_open(ws_root, 1, &ws);
     if (s == VF_OK && (s = vf_path_join(memory_path, sizeof memory_path, ws.root, MEMORY_FILE)) ==
                           VF_OK) {
         if (vf_is_file(memory_path) && vf_json_load(memory_path, &memory) != VF_OK)
@@ -166,16 +192,17 @@ vf_status vf_run(const char *ws_root, const vf_run_options *o, json_t **summary)
         if (!memory)
             memory = json_object();
         double start = vf_now();
-        s = run_stages(ws_root, &ws, o, calls, count, memory, memory_path);
+        s = run_stages(ws_root, &ws, &o, calls, count, memory, memory_path);
         if (s == VF_OK) {
             char card[VF_PATH_MAX], report[VF_PATH_MAX];
             vf_workspace_path(&ws, "export", "shot_card.png", card, sizeof card);
-            vf_workspace_path(&ws, "attack", "attack.json", report, sizeof report);
+            vf_workspace_path(&ws, attack_stage, "attack.json", report, sizeof report);
             const json_t *attack =
-                json_object_get(vf_workspace_stage_record(&ws, "attack"), "summary");
-            *summary = json_pack("{s:s, s:f, s:O, s:s, s:s}", "workspace", ws.root, "seconds",
-                                 vf_now() - start, "attack", attack ? attack : json_null(),
-                                 "shot_card", card, "attack_report", report);
+                json_object_get(vf_workspace_stage_record(&ws, attack_stage), "summary");
+            *summary = json_pack("{s:s, s:f, s:s, s:O, s:s, s:s}", "workspace", ws.root,
+                                 "seconds", vf_now() - start, "attack_name", name, "attack",
+                                 attack ? attack : json_null(), "shot_card", card,
+                                 "attack_report", report);
         }
     }
     for (int i = 0; i < count; i++)

@@ -23,6 +23,7 @@
 
 #include "studio_internal.h"
 #include "vf/attack_file.h"
+#include "vf/export.h"
 #include "vf/calib.h"
 #include "vf/fsutil.h"
 #include "vf/json.h"
@@ -320,7 +321,7 @@ vf_status vf__follow(vf_workspace *ws, capture_truth *t, const vf_similarity *to
     if (status == VF_OK)
         status = vf_targets_workspace_target(ws->root, o->target, &f.target, f.target_c2w);
     if (status == VF_OK)
-        status = vf_attack_file_load_workspace(ws, &attack);
+        status = vf_attack_file_load_workspace(ws, vf_export_attack(ws), &attack);
     if (status == VF_OK) {
         memcpy(f.range, attack.range, sizeof f.range);
         if (snprintf(work, sizeof work, "%s.studio", video) >= (int)sizeof work)

@@ -9,6 +9,7 @@
 
 #include "studio_internal.h"
 #include "vf/attack_file.h"
+#include "vf/export.h"
 #include "vf/dataset.h"
 #include "vf/fsutil.h"
 #include "vf/ingest.h"
@@ -297,7 +298,7 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
     if (status == VF_OK)
         status = vf_targets_workspace_target(ws->root, o->target, &target, NULL);
     if (status == VF_OK)
-        status = vf_attack_file_load_workspace(ws, &attack);
+        status = vf_attack_file_load_workspace(ws, vf_export_attack(ws), &attack);
     if (status == VF_OK)
         status = vf__align_workspace(ws, &t, &to_ws, &alignment);
     vf_studio_phone phone = o->phone;
@@ -435,7 +436,7 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
     if (status == VF_OK)
         status = vf_json_load(score_path, &score);
     if (status == VF_OK)
-        status = vf_attack_file_load_workspace(ws, &attack);
+        status = vf_attack_file_load_workspace(ws, vf_export_attack(ws), &attack);
     const json_t *frames = json_object_get(truth, "frames");
     const json_t *rows = json_object_get(score, "frames_detail");
     double center[VF_VIEW_DIM];
@@ -513,7 +514,7 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
     vf_real_rates real; /* the object's own side, when `vfcapture real` ran */
     int real_found = 0;
     if (status == VF_OK)
-        status = vf_real_load_rates(ws, &real, &real_found);
+        status = vf_real_load_rates(ws, attack.stage, &real, &real_found);
     if (status == VF_OK && report) {
         const json_t *k = json_object_get(score, "kept");
         *report = json_pack(

@@ -37,14 +37,14 @@ static void object_free(vbench_object *o)
     memset(o, 0, sizeof *o);
 }
 
-static vf_status load_object(const char *root, vbench_object *o)
+static vf_status load_object(const char *root, const char *attack, vbench_object *o)
 {
     vf_workspace ws;
     vf_status status = vf_workspace_open(root, 0, &ws);
     if (status != VF_OK)
         return status;
     vf_path_basename(o->name, sizeof o->name, ws.root, 0);
-    status = vf_attack_file_load_workspace(&ws, &o->attack);
+    status = vf_attack_file_load_workspace(&ws, attack, &o->attack);
     if (status == VF_OK && o->attack.components < 1)
         status = vf_fail(VF_EINPUT,
                          "%s: the attack kept no distribution p*(v) (random search): "
@@ -210,7 +210,7 @@ vf_status vf_vbench_build(const char *const *workspaces, int n, const char *out_
         return vf_fail(VF_EINTERNAL, "out of memory");
     vf_status status = VF_OK;
     for (int i = 0; i < n && status == VF_OK; i++)
-        status = load_object(workspaces[i], &objects[i]);
+        status = load_object(workspaces[i], opt->attack, &objects[i]);
     make_names_unique(objects, n);
 
     char partial[VF_PATH_MAX];
