@@ -99,5 +99,7 @@ int cmd_reshoot(int argc, char **argv);
 int cmd_real(int argc, char **argv);
 int cmd_models(int argc, char **argv);
 int cmd_simulate(int argc, char **argv);
+int cmd_study(int argc, char **argv);
+int cmd_tables(int argc, char **argv);
 
 #endif

@@ -23,6 +23,8 @@ static const cli_command commands[] = {
     {"classify", cmd_classify, "classify images with an ImageNet model, print top-5"},
     {"models", cmd_models, "list the classifiers found by name, with input size and engine"},
     {"benchmark", cmd_benchmark, "ImageNet-V style set from attacked objects; score classifiers"},
+    {"study", cmd_study, "many objects x classifiers x settings through Snakemake (or Slurm)"},
+    {"tables", cmd_tables, "the paper's tables of a study's finished workspaces"},
     {"info", cmd_info, "show a workspace's stages, parameters and outputs"},
     {"calib", cmd_calib, "camera calibration (checkerboard) and a workspace's metric scale"},
 };

@@ -10,6 +10,7 @@ packages=(
   libopencv-dev libopenimageio-dev openimageio-tools libceres-dev libeigen3-dev
   libv4l-dev v4l-utils libjansson-dev libcairo2-dev libsqlite3-dev python3
   blender python3-numpy python3-onnx
+  snakemake slurm-wlm munge bc  # studies (workflow/): Snakemake, and Slurm for the cluster test
 )
 # Node.js runs the ONNX Runtime worker; keep an installed node (and its npm) if there is one.
 command -v node >/dev/null || packages+=(nodejs)

@@ -2,7 +2,6 @@
 #define _GNU_SOURCE /* struct stat's st_mtim */
 #include "vf/ingest.h"
 
-#include <dirent.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,38 +44,20 @@ static vf_status hash_file(content_hash *c, const char *path)
     return failed ? vf_fail(VF_EINPUT, "cannot read %s", path) : VF_OK;
 }
 
-static int by_name(const void *a, const void *b)
+static int any_name(const char *name)
 {
-    return strcmp(*(char *const *)a, *(char *const *)b);
+    (void)name;
+    return 1;
 }
 
 /* A folder: its files' names and contents in name order (sub-folders are not read). */
 static vf_status hash_folder(content_hash *c, const char *dir, int *files)
 {
-    DIR *d = opendir(dir);
-    if (!d)
-        return vf_fail(VF_EINPUT, "cannot read the folder %s", dir);
     char **names = NULL;
-    size_t n = 0, cap = 0;
-    vf_status s = VF_OK;
-    for (struct dirent *e; (e = readdir(d)) != NULL && s == VF_OK;) {
-        if (e->d_name[0] == '.')
-            continue;
-        if (n == cap) {
-            char **grown = realloc(names, (cap = cap ? 2 * cap : 64) * sizeof *names);
-            if (!grown)
-                s = vf_fail(VF_EINTERNAL, "out of memory");
-            else
-                names = grown;
-        }
-        if (s == VF_OK && !(names[n++] = strdup(e->d_name)))
-            s = vf_fail(VF_EINTERNAL, "out of memory");
-    }
-    closedir(d);
-    if (s == VF_OK && n)
-        qsort(names, n, sizeof *names, by_name);
+    int n = 0;
+    vf_status s = vf_list_folder(dir, any_name, &names, &n);
     *files = 0;
-    for (size_t i = 0; i < n && s == VF_OK; i++) {
+    for (int i = 0; i < n && s == VF_OK; i++) {
         char path[VF_PATH_MAX];
         if ((s = vf_path_join(path, sizeof path, dir, names[i])) == VF_OK && vf_is_file(path)) {
             hash_bytes(c, (const unsigned char *)names[i], strlen(names[i]) + 1);
@@ -84,9 +65,7 @@ static vf_status hash_folder(content_hash *c, const char *dir, int *files)
             (*files)++;
         }
     }
-    for (size_t i = 0; i < n; i++)
-        free(names[i]);
-    free(names);
+    vf_free_names(names, n);
     return s;
 }
 

@@ -208,6 +208,8 @@ vf_status vf_workspace_need(const vf_workspace *ws, const char *stage)
     return VF_OK;
 }
 
+/* Whether a folder holds no file, in it or in its sub-folders (a workflow engine makes the
+ * folders of a stage's outputs before the stage runs: such a folder may become a workspace). */
 static int folder_is_empty(const char *path)
 {
     DIR *dir = opendir(path);
@@ -215,8 +217,13 @@ static int folder_is_empty(const char *path)
         return 0;
     struct dirent *entry;
     int empty = 1;
-    while (empty && (entry = readdir(dir)))
-        empty = !strcmp(entry->d_name, ".") || !strcmp(entry->d_name, "..");
+    while (empty && (entry = readdir(dir))) {
+        if (!strcmp(entry->d_name, ".") || !strcmp(entry->d_name, ".."))
+            continue;
+        char sub[VF_PATH_MAX];
+        empty = vf_path_join(sub, sizeof sub, path, entry->d_name) == VF_OK && vf_is_dir(sub) &&
+                folder_is_empty(sub);
+    }
     closedir(dir);
     return empty;
 }
