@@ -9,7 +9,7 @@ static const char usage[] =
     "usage: vfcapture info WS [--json]\n"
     "\n"
     "Show which stages have run in the workspace WS, when, with which parameters, and what\n"
-    "they reported.\n"
+    "they reported; a stage built on one rerun since is marked STALE.\n"
     "\n"
     "options:\n" CLI_COMMON_HELP;
 
@@ -44,9 +44,13 @@ int cmd_info(int argc, char **argv)
         json_object_foreach(json_object_get(ws.manifest, "stages"), name, record)
         {
             char *summary = json_dumps(json_object_get(record, "summary"), JSON_COMPACT);
-            printf("  %-8s done %s in %.1f s  %s\n", name,
+            char why[256], stale[300] = "";
+            if (vf_workspace_is_stale(&ws, name, why, sizeof why))
+                snprintf(stale, sizeof stale, "  STALE: %s", why);
+            printf("  %-8s done %s in %.1f s%s  %s\n", name,
                    text_or(json_object_get(record, "completed")),
-                   json_number_value(json_object_get(record, "seconds")), summary ? summary : "");
+                   json_number_value(json_object_get(record, "seconds")), stale,
+                   summary ? summary : "");
             free(summary);
         }
     }

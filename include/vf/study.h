@@ -19,7 +19,8 @@
  *   imagenet_v  per classifier: top-1 on natural and on adversarial viewpoints
  *   objects     one row per object and attack (the numbers the tables average)
  *   failed      objects that failed (stage and error line) and stale attacks
- *   costs       seconds each stage of each object took (from the manifests)
+ *   costs       wall seconds and peak memory of every job (the workflow's benchmark files,
+ *               STUDY/logs/OBJECT/STAGE.bench.tsv; else the manifests' seconds)
  *
  * Each as STUDY/tables/NAME.csv, all of them in STUDY/tables/tables.md with the paper's
  * numbers beside ours where the rows match (same space and method; the paper's classifiers

@@ -271,13 +271,53 @@ static vf_status read_attack(study *st, const vf_workspace *ws, const char *obje
     return s;
 }
 
+static int bench_file(const char *name)
+{
+    size_t n = strlen(name);
+    return n > 10 && !strcmp(name + n - 10, ".bench.tsv");
+}
+
+/* The workflow's benchmark files in dir (STAGE.bench.tsv: seconds, h:m:s, max_rss in MB, ...)
+ * as costs of `object`; returns how many there were. */
+static int read_bench_costs(study *st, const char *dir, const char *object)
+{
+    char **names = NULL;
+    int n = 0;
+    if (!vf_is_dir(dir) || vf_list_folder(dir, bench_file, &names, &n) != VF_OK)
+        return 0;
+    for (int i = 0; i < n; i++) {
+        char path[VF_PATH_MAX], *text = NULL, stage[128];
+        size_t size;
+        double seconds, rss;
+        snprintf(stage, sizeof stage, "%.*s", (int)(strlen(names[i]) - 10), names[i]);
+        if (vf_path_join(path, sizeof path, dir, names[i]) != VF_OK ||
+            vf_read_file(path, &text, &size) != VF_OK)
+            continue;
+        const char *line = strchr(text, '\n'); /* past the header */
+        if (line && sscanf(line + 1, "%lf %*s %lf", &seconds, &rss) == 2)
+            json_array_append_new(st->costs,
+                                  json_pack("{s:s, s:s, s:f, s:f}", "object", object, "stage",
+                                            stage, "seconds", seconds, "max_rss_mb", rss));
+        free(text);
+    }
+    vf_free_names(names, n);
+    return n;
+}
+
+/* What each job of the object cost: its benchmark files (STUDY/logs/OBJECT/), else the seconds
+ * the manifest records (a stage's own time, without loading). */
 static void read_costs(study *st, const vf_workspace *ws, const char *object)
 {
+    char dir[VF_PATH_MAX];
+    if (snprintf(dir, sizeof dir, "%s/logs/%s", st->dir, object) < (int)sizeof dir &&
+        read_bench_costs(st, dir, object) > 0)
+        return;
     const char *stage;
     json_t *record;
     json_object_foreach(json_object_get(ws->manifest, "stages"), stage, record)
-        json_array_append_new(st->costs, json_pack("{s:s, s:s, s:f}", "object", object, "stage",
-                                                   stage, "seconds", number(record, "seconds")));
+        json_array_append_new(st->costs, json_pack("{s:s, s:s, s:f, s:n}", "object", object,
+                                                   "stage", stage, "seconds",
+                                                   number(record, "seconds"), "max_rss_mb"));
 }
 
 static int folder_name(const char *name)
@@ -515,7 +555,7 @@ static void make_table2(const study *st, table *t, double *scratch)
 static void make_table3(const study *st, table *t, double *scratch)
 {
     static const char *head[] = {"attacked classifier", "method", "space", "model", "objects",
-                                 "ASR p*(v)", "ASR v*", "paper (ResNet-50 to MN-v2, l=0 / 0.01)",
+                                 "ASR p*(v)", "ASR v*", "paper p*(v) (ResNet-50 to MN-v2)",
                                  NULL};
     table_start(t, "table3", "Table 3: transfer of the adversarial viewpoints to other models",
                 head);
@@ -539,7 +579,12 @@ static void make_table3(const study *st, table *t, double *scratch)
             cell(t, "%s", r->model), cell(t, "%s", method), cell(t, "%s", r->space);
             cell(t, "%s", r->transfer_model[k]), cell(t, "%d", n);
             pct_ci(t, mean_of(s, n)), pct_ci(t, mean_of(v, n));
-            cell(t, "%s", strstr(r->transfer_model[k], "mobilenet_v2") ? "76.77 / 79.11" : "-");
+            /* the paper's MN-v2 column, ResNet-50's p*(v) at lambda 0 and 0.01 */
+            int mn_v2 = strstr(r->transfer_model[k], "mobilenet_v2") != NULL;
+            cell(t, "%s", !mn_v2 || !isfinite(r->lambda) ? "-"
+                          : r->lambda == 0                ? "76.77"
+                          : r->lambda == 0.01             ? "79.11"
+                                                          : "-");
         }
     }
 }
@@ -649,7 +694,7 @@ static vf_status write_all(study *st, json_t **result)
 {
     char dir[VF_PATH_MAX];
     static const char *failed_keys[] = {"object", "stage", "error", NULL};
-    static const char *cost_keys[] = {"object", "stage", "seconds", NULL};
+    static const char *cost_keys[] = {"object", "stage", "seconds", "max_rss_mb", NULL};
     double *scratch = malloc(2 * MAX_ROWS * sizeof *scratch);
     table tables[7];
     int count = 0;
@@ -665,7 +710,8 @@ static vf_status write_all(study *st, json_t **result)
         make_objects(st, &tables[count++]);
         make_list(&tables[count++], "failed", "Failed objects and stale attacks", st->failed,
                   failed_keys);
-        make_list(&tables[count++], "costs", "Seconds per stage", st->costs, cost_keys);
+        make_list(&tables[count++], "costs", "What each job cost: wall seconds and peak memory (MB)",
+                  st->costs, cost_keys);
     }
     text_out md;
     if (s == VF_OK && (s = text_begin(&md)) == VF_OK) {
@@ -716,6 +762,9 @@ vf_status vf_study_tables(const char *study_dir, json_t **result)
         s = vf_list_folder(study_dir, folder_name, &names, &n);
     for (int i = 0; i < n && s == VF_OK; i++)
         s = read_object(&st, names[i]);
+    char logs[VF_PATH_MAX]; /* the jobs over all objects (ImageNet-V) */
+    if (s == VF_OK && vf_path_join(logs, sizeof logs, study_dir, "logs") == VF_OK)
+        read_bench_costs(&st, logs, "(all)");
     if (s == VF_OK && st.objects == 0)
         s = vf_fail(VF_EINPUT, "%s holds no workspace: is it a study's folder (its 'out')?",
                     study_dir);
