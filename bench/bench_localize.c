@@ -63,9 +63,14 @@ static void bench(const char *ws, const vf_rgb8 *frames, int n, int max_features
     vf_localize_defaults(&opt);
     opt.max_features = max_features;
     opt.max_side = max_side;
-    vf_localizer *loc;
+    vf_localizer *loc = NULL;
+    vf_workspace workspace = {0};
     double start = vf_now();
-    if (vf_localizer_open(ws, &opt, &loc) != VF_OK) {
+    vf_status status = vf_workspace_open(ws, 0, &workspace);
+    if (status == VF_OK)
+        status = vf_localizer_open(&workspace, &opt, &loc);
+    vf_workspace_close(&workspace);
+    if (status != VF_OK) {
         fprintf(stderr, "bench_localize: %s\n", vf_error_message());
         exit(1);
     }

@@ -30,6 +30,7 @@
 #include "bench_shell.h"
 #include "vf/dataset.h"
 #include "vf/fsutil.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/pose.h"
 #include "vf/poses.h"
@@ -159,9 +160,10 @@ static json_t *pose_error(const char *ws, const vf_dataset *views, int n)
     vf_pose_agreement g;
     json_t *out = json_null();
     if (vf_pose_compare(a, b, m, VF_CAMERA_DISTANCE, &g) == VF_OK)
-        out = json_pack("{s:i, s:f, s:f, s:f, s:f}", "compared", m, "rotation_median_deg",
-                        g.rot_median, "rotation_p90_deg", g.rot_p90, "rotation_max_deg", g.rot_max,
-                        "position_median", g.pos_median);
+        out = json_pack("{s:i, s:o, s:o, s:o, s:o}", "compared", m, "rotation_median_deg",
+                        vf_json_number(g.rot_median), "rotation_p90_deg", vf_json_number(g.rot_p90),
+                        "rotation_max_deg", vf_json_number(g.rot_max), "position_median",
+                        vf_json_number(g.pos_median));
     free(a);
     free(b);
     vf_dataset_free(&ours);

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "calib_internal.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/pose.h"
 
@@ -151,13 +152,14 @@ vf_status vf_scale_from_marker(const vf_workspace *ws, int id, double size_m,
         json_t *points = json_array(), *sides = json_array(), *errors = json_array();
         for (int k = 0; k < 4; k++) {
             json_array_append_new(points, vf_json_doubles(X[k], 3));
-            json_array_append_new(sides, json_real(side[k]));
-            json_array_append_new(errors, json_real(residual[k]));
+            json_array_append_new(sides, vf_json_number(side[k]));
+            json_array_append_new(errors, vf_json_number(residual[k]));
         }
-        *details = json_pack("{s:i, s:s, s:f, s:o, s:o, s:o, s:f, s:o, s:f}", "marker_id", id,
-                             "dictionary", "ARUCO_ORIGINAL", "size_m", size_m, "frames", frames,
-                             "corners", points, "sides_units", sides, "side_units", mean,
-                             "reprojection_px", errors, "side_spread", spread);
+        *details = json_pack("{s:i, s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:o}", "marker_id", id,
+                             "dictionary", "ARUCO_ORIGINAL", "size_m", vf_json_number(size_m),
+                             "frames", frames, "corners", points, "sides_units", sides,
+                             "side_units", vf_json_number(mean), "reprojection_px", errors,
+                             "side_spread", vf_json_number(spread));
         frames = NULL;
     }
     json_decref(frames);
@@ -230,9 +232,11 @@ vf_status vf_scale_from_picks(const vf_workspace *ws, const vf_pick *p1, int n1,
                                     "different points");
     if (status == VF_OK) {
         *metres_per_unit = distance_m / units;
-        *details = json_pack("{s:f, s:[o, o], s:f, s:[f, f]}", "distance_m", distance_m, "points",
-                             vf_json_doubles(X[0], 3), vf_json_doubles(X[1], 3), "distance_units",
-                             units, "reprojection_px", residual[0], residual[1]);
+        *details =
+            json_pack("{s:o, s:[o, o], s:o, s:[o, o]}", "distance_m", vf_json_number(distance_m),
+                      "points", vf_json_doubles(X[0], 3), vf_json_doubles(X[1], 3),
+                      "distance_units", vf_json_number(units), "reprojection_px",
+                      vf_json_number(residual[0]), vf_json_number(residual[1]));
     }
     sightings_free(&s[0]);
     sightings_free(&s[1]);
@@ -289,8 +293,9 @@ vf_status vf_calib_scale_run(const char *ws_root, const vf_scale_request *r, jso
     char path[VF_PATH_MAX];
     status = measure(r, &ws, &s, &details);
     if (status == VF_OK) {
-        doc = json_pack("{s:f, s:f, s:s, s:o}", "metres_per_unit", s, "units_per_metre", 1.0 / s,
-                        "method", method, "details", details);
+        doc = json_pack("{s:o, s:o, s:s, s:o}", "metres_per_unit", vf_json_number(s),
+                        "units_per_metre", vf_json_number(1.0 / s), "method", method, "details",
+                        details);
         status = vf_stage_begin(&ws, "calib", &stage);
     } else {
         json_decref(details);
@@ -301,7 +306,7 @@ vf_status vf_calib_scale_run(const char *ws_root, const vf_scale_request *r, jso
             status = vf_json_save(path, doc);
         if (status == VF_OK)
             status = vf_stage_commit(&stage, json_pack("{s:s}", "method", method),
-                                     json_pack("{s:f}", "metres_per_unit", s));
+                                     json_pack("{s:o}", "metres_per_unit", vf_json_number(s)));
         else
             vf_stage_abort(&stage);
     }

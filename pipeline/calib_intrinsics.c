@@ -5,6 +5,7 @@
 
 #include "calib_cmd.h"
 #include "vf/fsutil.h"
+#include "vf/json.h"
 #include "vf/log.h"
 
 static const char usage[] =
@@ -74,18 +75,18 @@ static vf_status parse_option(int c, const char *arg, intrinsics_args *a)
         a->device = arg;
         return VF_OK;
     case OPT_SECONDS:
-        if (cli_parse_doubles(arg, &x, 1) != 1 || !(x > 0 && x <= 3600))
-            return vf_fail(VF_EINPUT, "--seconds: give a time from 0 to 3600 s");
+        if (cli_number_above("--seconds", arg, 0, 3600, &x) != VF_OK)
+            return VF_EINPUT;
         a->seconds = x;
         return VF_OK;
     case OPT_FRAMES:
     case OPT_MAX_VIEWS:
     case OPT_MIN_VIEWS:
-        if (cli_parse_int(arg, c == OPT_FRAMES ? 1 : 3, 100000, &n))
-            return vf_fail(VF_EINPUT, "%s: give a number from %d to 100000",
-                           c == OPT_FRAMES ? "--frames" : c == OPT_MAX_VIEWS ? "--max-views"
-                                                                             : "--min-views",
-                           c == OPT_FRAMES ? 1 : 3);
+        if (cli_count(c == OPT_FRAMES      ? "--frames"
+                      : c == OPT_MAX_VIEWS ? "--max-views"
+                                           : "--min-views",
+                      arg, c == OPT_FRAMES ? 1 : 3, 100000, &n) != VF_OK)
+            return VF_EINPUT;
         *(c == OPT_FRAMES ? &a->frames : c == OPT_MAX_VIEWS ? &a->calib.max_views
                                                             : &a->calib.min_views) = (int)n;
         return VF_OK;
@@ -156,22 +157,18 @@ static json_t *summary_json(const intrinsics_args *a, const vf_calib_result *r,
     json_t *per_view = json_array();
     for (int i = 0; i < v->count; i++)
         if (v->views[i].state != VF_VIEW_SPARE)
-            json_array_append_new(per_view, json_pack("{s:s, s:s, s:f}", "frame",
-                                                      v->views[i].name, "state",
-                                                      v->views[i].state == VF_VIEW_USED
-                                                          ? "used"
-                                                          : "outlier",
-                                                      "rms", v->views[i].rms));
-    return json_pack("{s:s, s:{s:f, s:f, s:f, s:f, s:i, s:i, s:f, s:f, s:f, s:f}, s:f, s:f, "
-                     "s:i, s:i, s:i, s:i, s:o, s:{s:f, s:f, s:f, s:f}}",
-                     "camera_file", a->output, "camera", "fl_x", c->fx, "fl_y", c->fy, "cx",
-                     c->cx, "cy", c->cy, "w", c->width, "h", c->height, "k1", c->k1, "k2", c->k2,
-                     "p1", c->p1, "p2", c->p2, "rms", r->rms, "rms_opencv", r->rms_opencv,
-                     "frames_searched", v->frames_seen, "boards_found", v->count, "views",
-                     r->used, "outlier_views", r->outliers, "per_view", per_view, "seconds",
-                     "detect", detect_s, "detect_per_frame",
-                     v->frames_seen ? detect_s / v->frames_seen : 0.0, "opencv",
-                     r->seconds_opencv, "ceres", r->seconds_ceres);
+            json_array_append_new(per_view,
+                                  json_pack("{s:s, s:s, s:o}", "frame", v->views[i].name, "state",
+                                            v->views[i].state == VF_VIEW_USED ? "used" : "outlier",
+                                            "rms", vf_json_number(v->views[i].rms)));
+    return json_pack(
+        "{s:s, s:o, s:o, s:o, s:i, s:i, s:i, s:i, s:o, s:{s:o, s:o, s:o, s:o}}",
+        "camera_file", a->output, "camera", vf_camera_json(c), "rms", vf_json_number(r->rms),
+        "rms_opencv", vf_json_number(r->rms_opencv), "frames_searched", v->frames_seen,
+        "boards_found", v->count, "views", r->used, "outlier_views", r->outliers, "per_view",
+        per_view, "seconds", "detect", vf_json_number(detect_s), "detect_per_frame",
+        vf_json_number(v->frames_seen ? detect_s / v->frames_seen : 0.0), "opencv",
+        vf_json_number(r->seconds_opencv), "ceres", vf_json_number(r->seconds_ceres));
 }
 
 static void print_summary(const json_t *s, const vf_calib_views *v)

@@ -7,27 +7,22 @@
 
 vf_status calib_parse_board(const char *text, vf_calib_board *board)
 {
-    char *end;
-    long cols = strtol(text, &end, 10), rows = 0;
-    if (*end == 'x' || *end == 'X') {
-        const char *second = end + 1;
-        rows = strtol(second, &end, 10);
-        if (end == second)
-            rows = 0;
-    }
-    if (*end || cols < 2 || rows < 2 || cols > 100 || rows > 100)
-        return vf_fail(VF_EINPUT, "--board: give the inner corners as COLSxROWS, e.g. 9x6 for a "
-                                  "board of 10 x 7 squares");
-    board->cols = (int)cols;
-    board->rows = (int)rows;
+    int cols, rows;
+    if (cli_size("--board", text, &cols, &rows) != VF_OK || cols < 2 || rows < 2 || cols > 100 ||
+        rows > 100)
+        return vf_fail(VF_EINPUT, "--board wants the inner corners as COLSxROWS from 2x2 to "
+                                  "100x100, e.g. 9x6 for a board of 10 x 7 squares, not '%s'",
+                       text);
+    board->cols = cols;
+    board->rows = rows;
     return VF_OK;
 }
 
 vf_status calib_parse_mm(const char *text, const char *what, double *metres)
 {
     double mm;
-    if (cli_parse_doubles(text, &mm, 1) != 1 || !(mm > 0) || mm > 1e6)
-        return vf_fail(VF_EINPUT, "%s: give a length in millimetres, e.g. 25", what);
+    if (cli_number_above(what, text, 0, 1e6, &mm) != VF_OK)
+        return VF_EINPUT; /* a length in millimetres */
     *metres = mm / 1000.0;
     return VF_OK;
 }

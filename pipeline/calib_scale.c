@@ -7,13 +7,13 @@
 #include "vf/log.h"
 
 static const char usage[] =
-    "usage: vfcapture calib scale WS (--marker ID --size MM | --distance P1 P2 MM)\n"
+    "usage: vfcapture calib scale WS (--marker ID --marker-size MM | --distance P1 P2 MM)\n"
     "\n"
     "Tie the workspace's scene units (the object frame of WS/poses/transforms.json) to metres,\n"
     "so that later commands can speak in metres. The result goes to WS/calib/scale.json as\n"
     "{\"metres_per_unit\": s, \"method\": ..., details}.\n"
     "\n"
-    "  --marker ID --size MM  an ArUco marker (original dictionary, OpenCV's\n"
+    "  --marker ID --marker-size MM  an ArUco marker (original dictionary, OpenCV's\n"
     "                         DICT_ARUCO_ORIGINAL; 'vfcapture calib marker' prints one) lying\n"
     "                         in the scene during the capture; MM is the side of its black\n"
     "                         square. Its corners are found in the posed frames and\n"
@@ -27,7 +27,7 @@ static const char usage[] =
     "\n"
     "options:\n" CLI_COMMON_HELP;
 
-enum { OPT_MARKER = CLI_OPT_FIRST_CUSTOM, OPT_SIZE, OPT_DISTANCE };
+enum { OPT_MARKER = CLI_OPT_FIRST_CUSTOM, OPT_SIZE, OPT_DISTANCE, OPT_OLD_SIZE };
 
 typedef struct scale_args {
     const char *workspace;
@@ -39,7 +39,8 @@ static vf_status parse_args(int argc, char **argv, scale_args *a, cli_flags *fla
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
         {"marker", required_argument, NULL, OPT_MARKER},
-        {"size", required_argument, NULL, OPT_SIZE},
+        {"marker-size", required_argument, NULL, OPT_SIZE},
+        {"size", required_argument, NULL, OPT_OLD_SIZE}, /* --size is an image's elsewhere */
         {"distance", required_argument, NULL, OPT_DISTANCE},
         {0, 0, 0, 0},
     };
@@ -52,13 +53,13 @@ static vf_status parse_args(int argc, char **argv, scale_args *a, cli_flags *fla
             continue;
         switch (c) {
         case OPT_MARKER:
-            if (cli_parse_int(optarg, 0, VF_ARUCO_IDS - 1, &marker))
-                return vf_fail(VF_EINPUT, "--marker: give an ArUco id from 0 to %d",
-                               VF_ARUCO_IDS - 1);
+            if (cli_count("--marker", optarg, 0, VF_ARUCO_IDS - 1, &marker) != VF_OK)
+                return VF_EINPUT;
             a->req.marker = (int)marker;
             break;
+        case OPT_OLD_SIZE: cli_deprecated("calib scale", "--size", "--marker-size"); /* fall through */
         case OPT_SIZE:
-            if ((status = calib_parse_mm(optarg, "--size", &a->req.size_m)) != VF_OK)
+            if ((status = calib_parse_mm(optarg, "--marker-size", &a->req.size_m)) != VF_OK)
                 return status;
             break;
         case OPT_DISTANCE: /* three values: P1 (optarg), then P2 and MM */
@@ -79,10 +80,10 @@ static vf_status parse_args(int argc, char **argv, scale_args *a, cli_flags *fla
     a->workspace = argv[optind];
     int by_marker = a->req.marker >= 0 || a->req.size_m > 0, by_distance = a->req.p1 != NULL;
     if (by_marker == by_distance)
-        return vf_fail(VF_EINPUT, "give either --marker ID --size MM or --distance P1 P2 MM");
+        return vf_fail(VF_EINPUT, "give either --marker ID --marker-size MM or --distance P1 P2 MM");
     if (by_marker && (a->req.marker < 0 || !(a->req.size_m > 0)))
-        return vf_fail(VF_EINPUT, "--marker needs --size MM (the side of the black square) and "
-                                  "--size needs --marker ID");
+        return vf_fail(VF_EINPUT, "--marker needs --marker-size MM (the side of the black square) "
+                                  "and --marker-size needs --marker ID");
     return VF_OK;
 }
 

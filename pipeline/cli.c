@@ -1,11 +1,15 @@
 #include "cli.h"
 
+#include <ctype.h>
 #include <errno.h>
+#include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "vf/classifier.h"
 #include "vf/log.h"
+#include "vf/resources.h"
 
 int cli_common_option(int opt, cli_flags *flags, const char *command, const char *usage)
 {
@@ -36,6 +40,11 @@ int cli_common_option(int opt, cli_flags *flags, const char *command, const char
     }
 }
 
+void cli_deprecated(const char *command, const char *old, const char *now)
+{
+    fprintf(stderr, "vfcapture %s: %s is deprecated: use %s\n", command, old, now);
+}
+
 int cli_fail(const char *command, vf_status status)
 {
     const char *message = vf_error_message();
@@ -54,31 +63,36 @@ void cli_print_json(json_t *doc)
     json_decref(doc);
 }
 
+/* Numbers are strict everywhere: the whole text, no blanks, finite, no empty list element;
+ * strtod and strtol alone take " 5", "nan", "inf" and "5," (and sscanf %d overflows). */
 int cli_parse_doubles(const char *text, double *out, int max)
 {
     int count = 0;
     const char *p = text;
-    while (*p) {
-        if (count == max)
-            return -1;
+    if (!*p)
+        return -1;
+    for (;;) {
         char *end;
-        errno = 0;
-        out[count] = strtod(p, &end);
-        if (end == p || errno)
+        if (count == max || isspace((unsigned char)*p))
             return -1;
-        count++;
+        errno = 0;
+        double x = strtod(p, &end);
+        if (end == p || errno || !isfinite(x))
+            return -1;
+        out[count++] = x;
         p = end;
-        if (*p == ',')
-            p++;
-        else if (*p)
+        if (!*p)
+            return count;
+        if (*p++ != ',')
             return -1;
     }
-    return count;
 }
 
 int cli_parse_int(const char *text, long lo, long hi, long *out)
 {
     char *end;
+    if (!*text || isspace((unsigned char)*text))
+        return -1;
     errno = 0;
     long value = strtol(text, &end, 10);
     if (end == text || *end || errno || value < lo || value > hi)
@@ -104,6 +118,18 @@ vf_status cli_count_int(const char *option, const char *text, long lo, long hi, 
     return status;
 }
 
+vf_status cli_seed(const char *option, const char *text, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long long value = isdigit((unsigned char)text[0]) ? strtoull(text, &end, 10) : 0;
+    if (!isdigit((unsigned char)text[0]) || *end || errno)
+        return vf_fail(VF_EINPUT, "%s wants a whole number from 0 to %llu, not '%s'", option,
+                       (unsigned long long)UINT64_MAX, text);
+    *out = (uint64_t)value;
+    return VF_OK;
+}
+
 vf_status cli_number(const char *option, const char *text, double lo, double hi, double *out)
 {
     double value;
@@ -114,15 +140,66 @@ vf_status cli_number(const char *option, const char *text, double lo, double hi,
     return VF_OK;
 }
 
+vf_status cli_number_above(const char *option, const char *text, double lo, double hi,
+                           double *out)
+{
+    double value;
+    if (cli_parse_doubles(text, &value, 1) != 1 || !(value > lo && value <= hi))
+        return vf_fail(VF_EINPUT, "%s wants a number above %g and up to %g, not '%s'", option,
+                       lo, hi, text);
+    *out = value;
+    return VF_OK;
+}
+
+vf_status cli_numbers(const char *option, const char *text, int n, const char *what,
+                      double *out)
+{
+    if (cli_parse_doubles(text, out, n) != n)
+        return vf_fail(VF_EINPUT, "%s wants %d comma-separated numbers (%s), not '%s'", option,
+                       n, what, text);
+    return VF_OK;
+}
+
 vf_status cli_size(const char *option, const char *text, int *width, int *height)
 {
-    char tail;
-    int w, h;
-    if (sscanf(text, "%dx%d%c", &w, &h, &tail) != 2 || w <= 0 || h <= 0 || w > 16384 ||
-        h > 16384)
-        return vf_fail(VF_EINPUT, "%s wants WIDTHxHEIGHT, e.g. 1280x720, not '%s'", option, text);
-    *width = w, *height = h;
+    const char *x = strchr(text, 'x');
+    long w = 0, h = 0;
+    char first[24];
+    if (x && (size_t)(x - text) < sizeof first) {
+        memcpy(first, text, (size_t)(x - text));
+        first[x - text] = 0;
+    }
+    if (!x || (size_t)(x - text) >= sizeof first || cli_parse_int(first, 1, 16384, &w) ||
+        cli_parse_int(x + 1, 1, 16384, &h))
+        return vf_fail(VF_EINPUT, "%s wants WIDTHxHEIGHT from 1x1 to 16384x16384, e.g. 1280x720, "
+                       "not '%s'", option, text);
+    *width = (int)w, *height = (int)h;
     return VF_OK;
+}
+
+vf_status cli_models(const char *option, const char *list, const char *models_dir,
+                     char paths[][VF_PATH_MAX], int max, int *count)
+{
+    *count = 0;
+    if (!strcmp(list, "all")) {
+        *count = vf_model_list(models_dir, paths, max);
+        return *count > 0 ? VF_OK
+                          : vf_fail(VF_EINPUT, "%s all: no model found (see 'vfcapture models')",
+                                    option);
+    }
+    char buf[4096];
+    if (snprintf(buf, sizeof buf, "%s", list) >= (int)sizeof buf)
+        return vf_fail(VF_EINPUT, "%s is too long", option);
+    char *save = NULL;
+    for (char *name = strtok_r(buf, ",", &save); name; name = strtok_r(NULL, ",", &save)) {
+        if (*count == max)
+            return vf_fail(VF_EINPUT, "%s: at most %d models at a time", option, max);
+        vf_status s = vf_find_model(name, models_dir, paths[*count], VF_PATH_MAX);
+        if (s != VF_OK)
+            return s;
+        (*count)++;
+    }
+    return *count ? VF_OK : vf_fail(VF_EINPUT, "%s names no model", option);
 }
 
 vf_status cli_open_trained(const char *root, vf_workspace *ws, vf_field **field)

@@ -8,6 +8,7 @@
 
 #include <getopt.h>
 #include <jansson.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include "vf/error.h"
@@ -55,25 +56,47 @@ typedef struct cli_command {
  * hint and exits 1. */
 int cli_common_option(int opt, cli_flags *flags, const char *command, const char *usage);
 
+/* A spelling kept from before the option vocabulary was made one (README, "Options"): warn
+ * once, "vfcapture COMMAND: OLD is deprecated: use NEW", and go on with its meaning. */
+void cli_deprecated(const char *command, const char *old, const char *now);
+
 /* Print "vfcapture COMMAND: error: <message>" for the current vf error and return status. */
 int cli_fail(const char *command, vf_status status);
 
 /* Print a JSON document on stdout (and take ownership of it). */
 void cli_print_json(json_t *doc);
 
+/* Numbers on the command line are strict: the whole text, no blanks, finite (no nan or inf),
+ * in range, every list element present ("5," is refused). Errors are one line in one style:
+ * "OPTION wants <what> from LO to HI, not 'TEXT'". */
+
 /* Parse "a,b,c" into at most max doubles; returns how many, or -1 when malformed. */
 int cli_parse_doubles(const char *text, double *out, int max);
 /* Parse a whole-string integer within [lo, hi]; returns 0 on success. */
 int cli_parse_int(const char *text, long lo, long hi, long *out);
-/* An option's whole number within [lo, hi], or VF_EINPUT "OPTION wants a whole number from LO
- * to HI, not 'TEXT'". */
+/* An option's whole number within [lo, hi] (VF_EINPUT "... wants a whole number from LO to HI"). */
 vf_status cli_count(const char *option, const char *text, long lo, long hi, long *out);
 /* The same into an int. */
 vf_status cli_count_int(const char *option, const char *text, long lo, long hi, int *out);
-/* An option's number within [lo, hi], or VF_EINPUT "OPTION wants a number from LO to HI". */
+/* An option's seed: any whole number from 0 to 2^64 - 1 (no sign, no overflow). */
+vf_status cli_seed(const char *option, const char *text, uint64_t *out);
+/* An option's number within [lo, hi] ("... wants a number from LO to HI"). */
 vf_status cli_number(const char *option, const char *text, double lo, double hi, double *out);
-/* An option's "WxH" (1..16384 each), or VF_EINPUT "OPTION wants WIDTHxHEIGHT". */
+/* An option's number within (lo, hi] ("... wants a number above LO and up to HI"). */
+vf_status cli_number_above(const char *option, const char *text, double lo, double hi,
+                           double *out);
+/* An option's list of exactly n numbers; `what` names them ("fx,fy,cx,cy in pixels"). */
+vf_status cli_numbers(const char *option, const char *text, int n, const char *what,
+                      double *out);
+/* An option's "WxH" (1..16384 each), or VF_EINPUT "OPTION wants WIDTHxHEIGHT ...". */
 vf_status cli_size(const char *option, const char *text, int *width, int *height);
+
+/* The classifiers an option names: "A,B,..." (names `vfcapture models` finds, or .onnx paths)
+ * or "all" (every model found), both looked up in models_dir first when given (NULL: the
+ * standard places). At most max; names resolved before any work, so a typo fails first. */
+#define CLI_MAX_MODELS 40
+vf_status cli_models(const char *option, const char *list, const char *models_dir,
+                     char paths[][VF_PATH_MAX], int max, int *count);
 
 /* Open the workspace at root (never created) and its trained field; on failure nothing stays
  * open. For the commands that only look at a field (render, eval, transfer). */

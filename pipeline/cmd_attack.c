@@ -36,8 +36,8 @@ static const char usage[] =
     "                         random (the baseline: 100 uniform viewpoints)\n"
     "      --lambda X         entropy weight (default 0.01): larger keeps p*(v) wider, 0 lets\n"
     "                         it shrink to a point\n"
-    "  -k, --samples K        viewpoints a step (default 50; pepg 51, the mean and 25 pairs)\n"
-    "  -n, --steps N          optimization steps (default 100)\n"
+    "      --samples K        viewpoints a step (default 50; pepg 51, the mean and 25 pairs)\n"
+    "      --steps N          optimization steps (default 100)\n"
     "      --components K     mixture of K Gaussians, 1..8 (nes only; default 1)\n"
     "      --space S          rotation (only the angles move), translation (only the\n"
     "                         offsets) or both (default); the fixed ones stay at the training\n"
@@ -62,6 +62,8 @@ enum {
     OPT_BOUNDS,
     OPT_SEED,
     OPT_RESTART,
+    OPT_SAMPLES,
+    OPT_STEPS,
 };
 
 typedef struct attack_cli {
@@ -69,25 +71,6 @@ typedef struct attack_cli {
     vf_attack_options attack;
     cli_flags flags;
 } attack_cli;
-
-static vf_status parse_double(const char *name, const char *text, double lo, double hi,
-                              double *out)
-{
-    if (cli_parse_doubles(text, out, 1) != 1 || !(*out >= lo && *out <= hi))
-        return vf_fail(VF_EINPUT, "--%s must be a number from %g to %g, not '%s'", name, lo, hi,
-                       text);
-    return VF_OK;
-}
-
-static vf_status parse_int(const char *name, const char *text, long lo, long hi, int *out)
-{
-    long v;
-    if (cli_parse_int(text, lo, hi, &v) != 0)
-        return vf_fail(VF_EINPUT, "--%s must be a whole number from %ld to %ld, not '%s'", name,
-                       lo, hi, text);
-    *out = (int)v;
-    return VF_OK;
-}
 
 static vf_status parse_options(int argc, char **argv, attack_cli *cli)
 {
@@ -100,8 +83,8 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
         {"label", required_argument, NULL, 'l'},
         {"method", required_argument, NULL, OPT_METHOD},
         {"lambda", required_argument, NULL, OPT_LAMBDA},
-        {"samples", required_argument, NULL, 'k'},
-        {"steps", required_argument, NULL, 'n'},
+        {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"steps", required_argument, NULL, OPT_STEPS},
         {"components", required_argument, NULL, OPT_COMPONENTS},
         {"space", required_argument, NULL, OPT_SPACE},
         {"bounds", required_argument, NULL, OPT_BOUNDS},
@@ -116,7 +99,6 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
            (c = getopt_long(argc, argv, CLI_COMMON_SHORT "m:l:k:n:", longopts, NULL)) != -1) {
         if (cli_common_option(c, &cli->flags, "attack", usage))
             continue;
-        char *end;
         switch (c) {
         case 'm': o->model = optarg; break;
         case OPT_MODELS_DIR: o->models_dir = optarg; break;
@@ -125,11 +107,14 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
             if (vf_attack_search_parse(optarg, &o->method) != VF_OK)
                 s = vf_fail(VF_EINPUT, "--method must be nes, pepg or random, not '%s'", optarg);
             break;
-        case OPT_LAMBDA: s = parse_double("lambda", optarg, 0, 1e6, &o->lambda); break;
-        case 'k': s = parse_int("samples", optarg, 2, 100000, &o->samples); break;
-        case 'n': s = parse_int("steps", optarg, 0, 100000, &o->steps); break;
+        case OPT_LAMBDA: s = cli_number("--lambda", optarg, 0, 1e6, &o->lambda); break;
+        case 'k': cli_deprecated("attack", "-k", "--samples"); /* fall through */
+        case OPT_SAMPLES: s = cli_count_int("--samples", optarg, 2, 100000, &o->samples); break;
+        case 'n': cli_deprecated("attack", "-n", "--steps"); /* fall through */
+        case OPT_STEPS: s = cli_count_int("--steps", optarg, 0, 100000, &o->steps); break;
         case OPT_COMPONENTS:
-            s = parse_int("components", optarg, 1, VF_ATTACK_MAX_COMPONENTS, &o->components);
+            s = cli_count_int("--components", optarg, 1, VF_ATTACK_MAX_COMPONENTS,
+                              &o->components);
             break;
         case OPT_SPACE:
             if (vf_view_space_parse(optarg, &o->space) != VF_OK)
@@ -137,11 +122,7 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
                             optarg);
             break;
         case OPT_BOUNDS: o->bounds = optarg; break;
-        case OPT_SEED:
-            o->seed = strtoull(optarg, &end, 10);
-            if (end == optarg || *end || optarg[0] == '-')
-                s = vf_fail(VF_EINPUT, "--seed must be a whole number >= 0, not '%s'", optarg);
-            break;
+        case OPT_SEED: s = cli_seed("--seed", optarg, &o->seed); break;
         case OPT_RESTART: o->restart = 1; break;
         case CLI_OPT_ATTACK: o->name = optarg; break;
         default: break;

@@ -10,7 +10,6 @@
 #include "vf/resources.h"
 #include "vf/vbench.h"
 
-#define MAX_MODELS 32
 
 static const char usage[] =
     "usage: vfcapture benchmark build WS... -o DIR [--count N] [--seed S] [--attack NAME]\n"
@@ -26,18 +25,20 @@ static const char usage[] =
     "\n"
     "options:\n"
     "  -o, --output DIR       build: the folder to create\n"
-    "  -n, --count N          build: images per object and split (default 100)\n"
+    "      --count N          build: images per object and split (default 100)\n"
     "      --seed S           build: sampling seed (default 0)\n"
     "      --attack NAME      build: which attack of each workspace (needed only when one has\n"
     "                         several)\n"
     "      --models LIST      eval: model names or .onnx paths, comma-separated, or 'all' for\n"
     "                         every model found by name (see vfcapture models; default " VF_DEFAULT_MODEL
-    ")\n" CLI_ENGINE_HELP CLI_COMMON_HELP;
+    ")\n"
+    "      --models-dir DIR   eval: look for model names (and 'all') here first\n" CLI_ENGINE_HELP
+        CLI_COMMON_HELP;
 
-enum { OPT_SEED = CLI_OPT_FIRST_CUSTOM, OPT_MODELS };
+enum { OPT_SEED = CLI_OPT_FIRST_CUSTOM, OPT_MODELS, OPT_COUNT, OPT_MODELS_DIR };
 
 typedef struct benchmark_options {
-    const char *output, *models;
+    const char *output, *models, *models_dir;
     vf_vbench_build_options build;
     cli_flags flags;
 } benchmark_options;
@@ -49,65 +50,35 @@ static vf_status parse_options(int argc, char **argv, benchmark_options *opt)
         CLI_ENGINE_OPTION,
         CLI_ATTACK_OPTION,
         {"output", required_argument, NULL, 'o'},
-        {"count", required_argument, NULL, 'n'},
+        {"count", required_argument, NULL, OPT_COUNT},
         {"seed", required_argument, NULL, OPT_SEED},
         {"models", required_argument, NULL, OPT_MODELS},
+        {"models-dir", required_argument, NULL, OPT_MODELS_DIR},
         {0, 0, 0, 0},
     };
     int c;
-    long value;
     while ((c = getopt_long(argc, argv, CLI_COMMON_SHORT "o:n:", longopts, NULL)) != -1) {
         if (cli_common_option(c, &opt->flags, "benchmark", usage))
             continue;
         if (c == 'o') {
             opt->output = optarg;
-        } else if (c == 'n') {
-            if (cli_parse_int(optarg, 1, 100000, &value) != 0)
-                return vf_fail(VF_EINPUT, "--count must be a whole number from 1 to 100000");
-            opt->build.count = (int)value;
+        } else if (c == 'n' || c == OPT_COUNT) {
+            if (c == 'n')
+                cli_deprecated("benchmark", "-n", "--count");
+            if (cli_count_int("--count", optarg, 1, 100000, &opt->build.count) != VF_OK)
+                return VF_EINPUT;
         } else if (c == OPT_SEED) {
-            if (cli_parse_int(optarg, 0, 2147483647L, &value) != 0)
-                return vf_fail(VF_EINPUT, "--seed must be a whole number >= 0");
-            opt->build.seed = (uint64_t)value;
+            if (cli_seed("--seed", optarg, &opt->build.seed) != VF_OK)
+                return VF_EINPUT;
         } else if (c == OPT_MODELS) {
             opt->models = optarg;
+        } else if (c == OPT_MODELS_DIR) {
+            opt->models_dir = optarg;
         } else if (c == CLI_OPT_ATTACK) {
             opt->build.attack = optarg;
         }
     }
     return VF_OK;
-}
-
-/* Every model vf_model_list finds. */
-static vf_status all_models(char **paths, int *count)
-{
-    static char found[MAX_MODELS][VF_PATH_MAX];
-    int n = vf_model_list(NULL, found, MAX_MODELS);
-    for (*count = 0; *count < n && *count < MAX_MODELS; (*count)++)
-        if (!(paths[*count] = strdup(found[*count])))
-            return vf_fail(VF_EINTERNAL, "out of memory");
-    return VF_OK;
-}
-
-static vf_status resolve_models(const char *list, char **paths, int *count)
-{
-    *count = 0;
-    if (list && !strcmp(list, "all"))
-        return all_models(paths, count);
-    char *copy = strdup(list ? list : VF_DEFAULT_MODEL), *save = NULL;
-    vf_status status = copy ? VF_OK : vf_fail(VF_EINTERNAL, "out of memory");
-    for (char *name = copy ? strtok_r(copy, ",", &save) : NULL; name && status == VF_OK;
-         name = strtok_r(NULL, ",", &save)) {
-        char path[VF_PATH_MAX];
-        if (*count == MAX_MODELS)
-            status = vf_fail(VF_EINPUT, "at most %d models at once", MAX_MODELS);
-        if (status == VF_OK)
-            status = vf_find_model(name, NULL, path, sizeof path);
-        if (status == VF_OK && !(paths[(*count)++] = strdup(path)))
-            status = vf_fail(VF_EINTERNAL, "out of memory");
-    }
-    free(copy);
-    return status;
 }
 
 static void print_results(const vf_vbench_results *r, const char *dir)
@@ -149,10 +120,14 @@ static json_t *results_json(const vf_vbench_results *r)
 
 static int run_eval(const benchmark_options *opt, const char *dir)
 {
-    char *models[MAX_MODELS] = {0};
+    static char found[CLI_MAX_MODELS][VF_PATH_MAX];
+    char *models[CLI_MAX_MODELS] = {0};
     int count = 0;
     vf_vbench_results results = {0};
-    vf_status status = resolve_models(opt->models, models, &count);
+    vf_status status = cli_models("--models", opt->models ? opt->models : VF_DEFAULT_MODEL,
+                                  opt->models_dir, found, CLI_MAX_MODELS, &count);
+    for (int i = 0; i < count; i++)
+        models[i] = found[i];
     if (status == VF_OK)
         status = vf_vbench_eval(dir, (const char *const *)models, count, &results);
     if (status == VF_OK)
@@ -164,8 +139,6 @@ static int run_eval(const benchmark_options *opt, const char *dir)
             print_results(&results, dir);
     }
     vf_vbench_results_free(&results);
-    for (int i = 0; i < count; i++)
-        free(models[i]);
     return status == VF_OK ? 0 : cli_fail("benchmark", status);
 }
 

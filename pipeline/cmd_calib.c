@@ -14,7 +14,7 @@ static const char usage[] =
     "             calibrate a camera from views of a checkerboard (or ChArUco board,\n"
     "             --charuco MM); the camera file feeds\n"
     "             'vfcapture poses --camera'\n"
-    "  scale WS (--marker ID --size MM | --distance P1 P2 MM)\n"
+    "  scale WS (--marker ID --marker-size MM | --distance P1 P2 MM)\n"
     "             give a posed workspace metric scale (WS/calib/scale.json)\n"
     "  board --board COLSxROWS -o board.png [--square-px N] [--charuco [--dict NAME]]\n"
     "             write a printable checkerboard or ChArUco board\n"
@@ -34,7 +34,7 @@ static int print_pattern(int argc, char **argv, int marker)
                              "\n"
                              "Write ArUco marker ID (original dictionary, 0..1023; OpenCV's\n"
                              "DICT_ARUCO_ORIGINAL) as a PNG: 7 x 7 cells with a white margin.\n"
-                             "Print it flat; its size for 'calib scale --size' is the side of\n"
+                             "Print it flat; its size for 'calib scale --marker-size' is the side of\n"
                              "the black square.\n"
                              "\n"
                              "options:\n"
@@ -85,11 +85,10 @@ static int print_pattern(int argc, char **argv, int marker)
             board.marker = VF_CHARUCO_MARKER_RATIO * board.square;
         else if (c == OPT_DICT && !marker)
             status = vf_charuco_dictionary(optarg, &board.dictionary);
-        else if (c == OPT_ID && marker && cli_parse_int(optarg, 0, VF_ARUCO_IDS - 1, &id))
-            status = vf_fail(VF_EINPUT, "--id: give an id from 0 to %d", VF_ARUCO_IDS - 1);
-        else if (c == OPT_PX && cli_parse_int(optarg, 4, 1000, &px))
-            status = vf_fail(VF_EINPUT, "%s: give a number of pixels from 4 to 1000",
-                             marker ? "--cell-px" : "--square-px");
+        else if (c == OPT_ID && marker)
+            status = cli_count("--id", optarg, 0, VF_ARUCO_IDS - 1, &id);
+        else if (c == OPT_PX)
+            status = cli_count(marker ? "--cell-px" : "--square-px", optarg, 4, 1000, &px);
         else if (marker ? c == OPT_BOARD || c == OPT_CHARUCO || c == OPT_DICT : c == OPT_ID)
             status = vf_fail(VF_EINPUT, "see 'vfcapture %s --help' for the options", name);
     }

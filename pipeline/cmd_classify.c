@@ -10,6 +10,7 @@
 #include "vf/classifier.h"
 #include "vf/fsutil.h"
 #include "vf/image.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/resources.h"
 
@@ -66,9 +67,8 @@ static vf_status parse_options(int argc, char **argv, classify_options *opt)
             opt->model = optarg;
         else if (c == OPT_MODELS_DIR)
             opt->models_dir = optarg;
-        else if (c == 'k' && cli_parse_int(optarg, 1, VF_NUM_CLASSES, &top) != 0)
-            return vf_fail(VF_EINPUT, "--top must be a whole number from 1 to %d, not '%s'",
-                           VF_NUM_CLASSES, optarg);
+        else if (c == 'k' && cli_count("--top", optarg, 1, VF_NUM_CLASSES, &top) != VF_OK)
+            return VF_EINPUT;
         else if (c == 'k')
             opt->top = (int)top;
         else if (c == 'l')
@@ -102,8 +102,9 @@ static json_t *top_json(const int *idx, const float *p, int k)
 {
     json_t *list = json_array();
     for (int j = 0; j < k; j++)
-        json_array_append_new(list, json_pack("{s:i, s:s, s:f}", "class", idx[j], "name",
-                                              vf_class_name(idx[j]), "probability", (double)p[j]));
+        json_array_append_new(list, json_pack("{s:i, s:s, s:o}", "class", idx[j], "name",
+                                              vf_class_name(idx[j]), "probability",
+                                              vf_json_number((double)p[j])));
     return list;
 }
 
@@ -200,7 +201,7 @@ static vf_status run(const classify_options *opt)
         json_t *doc = json_pack("{s:s, s:s, s:i, s:o}", "model", model_path, "engine", engine,
                                 "input_size", size, "images", list);
         if (opt->label_count)
-            json_object_set_new(doc, "accuracy", json_real(accuracy));
+            json_object_set_new(doc, "accuracy", vf_json_number(accuracy));
         cli_print_json(doc);
     } else {
         json_decref(list);

@@ -17,7 +17,7 @@ static const char usage[] =
     "Writes WS/export/targets.json, targets.csv, previews/ and shot_card.png.\n"
     "\n"
     "options:\n"
-    "  -n, --count M          samples of p*(v) besides v* (default 8)\n" CLI_ATTACK_HELP
+    "      --count M          samples of p*(v) besides v* (default 8)\n" CLI_ATTACK_HELP
         CLI_ENGINE_HELP CLI_COMMON_HELP;
 
 static vf_status parse(int argc, char **argv, const char **ws, vf_export_options *o,
@@ -26,7 +26,7 @@ static vf_status parse(int argc, char **argv, const char **ws, vf_export_options
     static const struct option longopts[] = {CLI_COMMON_OPTIONS,
                                              CLI_ENGINE_OPTION,
                                              CLI_ATTACK_OPTION,
-                                             {"count", required_argument, NULL, 'n'},
+                                             {"count", required_argument, NULL, CLI_OPT_FIRST_CUSTOM},
                                              {0, 0, 0, 0}};
     int c;
     long n;
@@ -35,10 +35,11 @@ static vf_status parse(int argc, char **argv, const char **ws, vf_export_options
             continue;
         if (c == CLI_OPT_ATTACK)
             o->attack = optarg;
-        if (c == 'n') {
-            if (cli_parse_int(optarg, 0, VF_EXPORT_MAX_COUNT, &n))
-                return vf_fail(VF_EINPUT, "--count: give a number from 0 to %d",
-                               VF_EXPORT_MAX_COUNT);
+        if (c == 'n')
+            cli_deprecated("export", "-n", "--count");
+        if (c == 'n' || c == CLI_OPT_FIRST_CUSTOM) {
+            if (cli_count("--count", optarg, 0, VF_EXPORT_MAX_COUNT, &n) != VF_OK)
+                return VF_EINPUT;
             o->count = (int)n;
         }
     }

@@ -1,6 +1,5 @@
 /* vfcapture ingest: parse the options, run the ingest stage (vf/ingest.h), print the summary. */
 #define _GNU_SOURCE
-#include <limits.h>
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
@@ -50,7 +49,7 @@ static const char usage[] =
     "      --render-size PX   model: side of the square renders (default 256: the\n"
     "                         classifier's 224 crop then sees the field at the\n"
     "                         resolution it was trained at; NeRF-synthetic is 200)\n"
-    "      --samples N        model: Cycles samples a pixel (default 32)\n"
+    "      --render-samples N model: Cycles samples a pixel (default 32)\n"
     "      --seed S           model: where on the hemisphere the views are (default 0)\n"
     "      --scene S          model: studio (white, transparent background; the paper's) or\n"
     "                         room (on a textured floor inside a textured wall, as a photo in\n"
@@ -77,6 +76,7 @@ enum {
     OPT_TEST_VIEWS,
     OPT_RENDER_SIZE,
     OPT_SAMPLES,
+    OPT_OLD_SAMPLES,
     OPT_SEED,
     OPT_SCENE,
 };
@@ -91,8 +91,9 @@ static vf_status apply_model_option(int c, const char *arg, vf_object3d_capture 
     } limits[] = {{OPT_VIEWS, "--views", 3, 10000},
                   {OPT_TEST_VIEWS, "--test-views", 0, 10000},
                   {OPT_RENDER_SIZE, "--render-size", 16, 4096},
-                  {OPT_SAMPLES, "--samples", 1, 65536},
-                  {OPT_SEED, "--seed", 0, LONG_MAX}};
+                  {OPT_SAMPLES, "--render-samples", 1, 65536}};
+    if (c == OPT_SEED)
+        return cli_seed("--seed", arg, &m->seed);
     for (size_t i = 0; i < sizeof limits / sizeof limits[0]; i++) {
         long n;
         if (limits[i].option != c)
@@ -101,10 +102,7 @@ static vf_status apply_model_option(int c, const char *arg, vf_object3d_capture 
         if (s != VF_OK)
             return s;
         int *field[] = {&m->views, &m->test_views, &m->size, &m->samples};
-        if (c == OPT_SEED)
-            m->seed = (uint64_t)n;
-        else
-            *field[i] = (int)n;
+        *field[i] = (int)n;
     }
     return VF_OK;
 }
@@ -139,6 +137,12 @@ static vf_status apply_option(int c, const char *arg, ingest_options *opt)
     case OPT_VIEWS:
     case OPT_TEST_VIEWS:
     case OPT_RENDER_SIZE:
+    case OPT_OLD_SAMPLES:
+        if (c == OPT_OLD_SAMPLES) { /* --samples is the attack's */
+            cli_deprecated("ingest", "--samples", "--render-samples");
+            c = OPT_SAMPLES;
+        }
+        /* fall through */
     case OPT_SAMPLES:
     case OPT_SEED: return apply_model_option(c, arg, &opt->req.model);
     case OPT_SCENE:
@@ -176,7 +180,8 @@ static int parse_options(int argc, char **argv, ingest_options *opt)
         {"views", required_argument, NULL, OPT_VIEWS},
         {"test-views", required_argument, NULL, OPT_TEST_VIEWS},
         {"render-size", required_argument, NULL, OPT_RENDER_SIZE},
-        {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"render-samples", required_argument, NULL, OPT_SAMPLES},
+        {"samples", required_argument, NULL, OPT_OLD_SAMPLES},
         {"seed", required_argument, NULL, OPT_SEED},
         {"scene", required_argument, NULL, OPT_SCENE},
         {0, 0, 0, 0},

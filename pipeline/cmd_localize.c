@@ -6,6 +6,7 @@
 #include "cli.h"
 #include "physical.h"
 #include "vf/frames.h"
+#include "vf/json.h"
 #include "vf/log.h"
 
 static const char usage[] =
@@ -93,15 +94,18 @@ int cmd_localize(int argc, char **argv)
     vf_status status = parse(argc, argv, &lo, &flags);
     if (status != VF_OK)
         return cli_fail("localize", status);
-    const char *ws = argv[optind];
+    const char *root = argv[optind];
+    vf_workspace ws = {0};
     vf_localizer *loc = NULL;
     vf_frames in = {0};
     json_t *frames = json_array();
     int localized = 0, total = 0;
     double seconds = 0;
-    status = vf_frames_open(argv + optind + 1, argc - optind - 1, &in);
+    status = vf_workspace_open(root, 0, &ws);
     if (status == VF_OK)
-        status = vf_localizer_open(ws, &lo, &loc);
+        status = vf_frames_open(argv + optind + 1, argc - optind - 1, &in);
+    if (status == VF_OK)
+        status = vf_localizer_open(&ws, &lo, &loc);
     if (status == VF_OK) {
         int points, descriptors;
         vf_localizer_map_size(loc, &points, &descriptors);
@@ -110,14 +114,16 @@ int cmd_localize(int argc, char **argv)
     }
     vf_localizer_close(loc);
     vf_frames_close(&in);
+    vf_workspace_close(&ws);
     if (status != VF_OK) {
         json_decref(frames);
         return cli_fail("localize", status);
     }
     if (flags.json) {
-        cli_print_json(json_pack("{s:s, s:i, s:i, s:f, s:o}", "workspace", ws, "localized",
+        cli_print_json(json_pack("{s:s, s:i, s:i, s:o, s:o}", "workspace", root, "localized",
                                  localized, "total", total, "frames_per_second",
-                                 seconds > 0 ? total / seconds : 0.0, "frames", frames));
+                                 vf_json_number(seconds > 0 ? total / seconds : 0.0), "frames",
+                                 frames));
     } else {
         json_decref(frames);
         vf_info("localized %d of %d frames (%.1f frames/s)", localized, total,

@@ -71,16 +71,20 @@ static vf_status parse_option(int c, const char *arg, vf_poses_options *opt)
     switch (c) {
     case OPT_MATCHER: opt->matcher = arg; return VF_OK;
     case OPT_OVERLAP:
-        if (cli_parse_int(arg, 1, 1000, &n))
-            return vf_fail(VF_EINPUT, "--overlap: give a number of frames from 1 to 1000");
+        if (cli_count("--overlap", arg, 1, 1000, &n) != VF_OK)
+            return VF_EINPUT;
         opt->overlap = (int)n;
         return VF_OK;
     case OPT_VOCAB_TREE: opt->vocab_tree = arg; return VF_OK;
     case OPT_CAMERA_MODEL: opt->camera_model = arg; return VF_OK;
     case OPT_INTRINSICS:
-        if (cli_parse_doubles(arg, x, 4) != 4 || !(x[0] > 0 && x[1] > 0 && x[2] > 0 && x[3] > 0))
-            return vf_fail(VF_EINPUT, "--intrinsics: give fx,fy,cx,cy in pixels, e.g. "
-                                      "1000,1000,640,360");
+        if (cli_numbers("--intrinsics", arg, 4, "fx,fy,cx,cy in pixels", x) != VF_OK)
+            return VF_EINPUT;
+        if (!(x[0] > 0 && x[1] > 0 && x[2] > 0 && x[3] > 0))
+            return vf_fail(VF_EINPUT,
+                           "--intrinsics wants fx,fy,cx,cy above 0, e.g. "
+                           "1000,1000,640,360, not '%s'",
+                           arg);
         opt->known = (vf_camera){.fx = x[0], .fy = x[1], .cx = x[2], .cy = x[3]};
         opt->has_intrinsics = 1;
         opt->camera_file = NULL;
@@ -90,13 +94,13 @@ static vf_status parse_option(int c, const char *arg, vf_poses_options *opt)
         opt->camera_file = arg;
         return vf_calib_load_camera(arg, &opt->known);
     case OPT_MAX_FEATURES:
-        if (cli_parse_int(arg, 100, 100000, &n))
-            return vf_fail(VF_EINPUT, "--max-features: give a number from 100 to 100000");
+        if (cli_count("--max-features", arg, 100, 100000, &n) != VF_OK)
+            return VF_EINPUT;
         opt->max_features = (int)n;
         return VF_OK;
     case OPT_MIN_REGISTERED:
-        if (cli_parse_doubles(arg, x, 1) != 1 || !(x[0] > 0 && x[0] <= 1))
-            return vf_fail(VF_EINPUT, "--min-registered: give a share in (0, 1], e.g. 0.5");
+        if (cli_number_above("--min-registered", arg, 0, 1, x) != VF_OK)
+            return VF_EINPUT;
         opt->min_registered = x[0];
         return VF_OK;
     case OPT_NO_UNDISTORT:

@@ -1,7 +1,6 @@
 /* vfcapture real: the attack's viewpoints checked against the object itself (a workspace made
  * from a 3D model, or filmed by the studio). The work is vf_real_run (vf/object3d.h); this
  * parses and prints. */
-#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 
@@ -72,8 +71,8 @@ static vf_status parse_options(int argc, char **argv, real_options *opt)
             opt->real.fluctuation_samples = (int)n;
         else if (c == OPT_NATURAL && (s = cli_count("--natural-views", optarg, 1, 100000, &n)) == VF_OK)
             opt->real.natural_views = (int)n;
-        else if (c == OPT_SEED && (s = cli_count("--seed", optarg, 0, LONG_MAX, &n)) == VF_OK)
-            opt->real.seed = (uint64_t)n;
+        else if (c == OPT_SEED)
+            s = cli_seed("--seed", optarg, &opt->real.seed);
     }
     if (s != VF_OK)
         return s;

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/pose.h"
 
@@ -10,11 +11,11 @@ static const char usage[] =
     "usage: vfcapture render WS (--viewpoint PSI,THETA,PHI,DX,DY,DZ | --pose M00,...,M33)\n"
     "                       [--size PX] -o OUT.png\n"
     "\n"
-    "Render the trained field of WS (WS/train/model.vff) from a viewpoint of DESIGN.md's\n"
-    "parameterization (angles in degrees, offsets in scene units; the camera looks at the\n"
-    "object from distance 4 + dy) or from a camera-to-world matrix (16 numbers, row-major,\n"
-    "object frame, OpenGL camera axes). The image is the classifier's square view: the\n"
-    "training camera's centre crop at PX x PX.\n"
+    "Render the trained field of WS (WS/train/model.vff) from a ViewFool viewpoint (psi,\n"
+    "theta, phi: rotations about the object in degrees; dx, dy, dz: offsets in scene units;\n"
+    "the camera looks at the object from distance 4 + dy) or from a camera-to-world matrix\n"
+    "(16 numbers, row-major, object frame, OpenGL camera axes). The image is the\n"
+    "classifier's square view: the training camera's centre crop at PX x PX.\n"
     "\n"
     "options:\n"
     "      --viewpoint V      psi,theta,phi,dx,dy,dz\n"
@@ -48,20 +49,20 @@ static vf_status parse_options(int argc, char **argv, render_options *opt)
         if (cli_common_option(c, &opt->flags, "render", usage))
             continue;
         if (c == OPT_VIEWPOINT) {
-            if (cli_parse_doubles(optarg, v, VF_VIEW_DIM) != VF_VIEW_DIM)
-                return vf_fail(VF_EINPUT, "--viewpoint needs 6 numbers psi,theta,phi,dx,dy,dz, "
-                                          "not '%s'", optarg);
+            if (cli_numbers("--viewpoint", optarg, VF_VIEW_DIM, "psi,theta,phi,dx,dy,dz", v) !=
+                VF_OK)
+                return VF_EINPUT;
             vf_viewpoint p = vf_viewpoint_from_array(v);
             vf_viewpoint_to_c2w(&p, opt->c2w);
             opt->have_pose = 1;
         } else if (c == OPT_POSE) {
-            if (cli_parse_doubles(optarg, opt->c2w, 16) != 16)
-                return vf_fail(VF_EINPUT, "--pose needs 16 comma-separated numbers, not '%s'",
-                               optarg);
+            if (cli_numbers("--pose", optarg, 16, "a 4x4 camera-to-world matrix by rows",
+                            opt->c2w) != VF_OK)
+                return VF_EINPUT;
             opt->have_pose = 1;
         } else if (c == OPT_SIZE) {
-            if (cli_parse_int(optarg, 16, 4096, &size) != 0)
-                return vf_fail(VF_EINPUT, "--size must be a whole number from 16 to 4096");
+            if (cli_count("--size", optarg, 16, 4096, &size) != VF_OK)
+                return VF_EINPUT;
             opt->size = (int)size;
         } else if (c == 'o') {
             opt->output = optarg;
@@ -95,8 +96,8 @@ int cmd_render(int argc, char **argv)
     if (status == VF_OK)
         status = vf_image_save(opt.output, &image);
     if (status == VF_OK && opt.flags.json)
-        cli_print_json(json_pack("{s:s, s:i, s:f}", "image", opt.output, "size", opt.size,
-                                 "render_ms", ms));
+        cli_print_json(json_pack("{s:s, s:i, s:o}", "image", opt.output, "size", opt.size,
+                                 "render_ms", vf_json_number(ms)));
     else if (status == VF_OK)
         vf_info("rendered %dx%d in %.1f ms: %s", opt.size, opt.size, ms, opt.output);
     vf_image_free(&image);

@@ -52,30 +52,30 @@ static vf_status parse_value(int c, const char *arg, reshoot_options *o)
     double x;
     switch (c) {
     case OPT_TARGET:
-        if (cli_parse_int(arg, 0, 100000, &n))
-            return vf_fail(VF_EINPUT, "--target: give a target number (0 is v*)");
+        if (cli_count("--target", arg, 0, 100000, &n) != VF_OK) /* 0 is v* */
+            return VF_EINPUT;
         o->reshoot.target = (int)n;
         return VF_OK;
     case OPT_V4L2: o->reshoot.device = arg; return VF_OK;
     case OPT_VIDEO: o->reshoot.video = arg; return VF_OK;
     case OPT_TOLERANCE:
-        if (cli_parse_doubles(arg, &x, 1) != 1 || !(x > 0 && x <= 100))
-            return vf_fail(VF_EINPUT, "--tolerance: give a percentage in (0, 100], e.g. 5");
+        if (cli_number_above("--tolerance", arg, 0, 100, &x) != VF_OK) /* percent */
+            return VF_EINPUT;
         o->reshoot.tolerance = x / 100;
         return VF_OK;
     case OPT_SMOOTHING:
-        if (cli_parse_doubles(arg, &x, 1) != 1 || !(x > 0 && x <= 1))
-            return vf_fail(VF_EINPUT, "--smoothing: give a weight in (0, 1], e.g. 0.4");
+        if (cli_number_above("--smoothing", arg, 0, 1, &x) != VF_OK)
+            return VF_EINPUT;
         o->reshoot.smoothing = x;
         return VF_OK;
     case OPT_SECONDS:
-        if (cli_parse_doubles(arg, &x, 1) != 1 || !(x > 0))
-            return vf_fail(VF_EINPUT, "--seconds: give a positive number of seconds");
+        if (cli_number_above("--seconds", arg, 0, 86400, &x) != VF_OK)
+            return VF_EINPUT;
         o->reshoot.seconds = x;
         return VF_OK;
     case OPT_EVERY:
-        if (cli_parse_int(arg, 1, 1000, &n))
-            return vf_fail(VF_EINPUT, "--every: give a number from 1 to 1000");
+        if (cli_count("--every", arg, 1, 1000, &n) != VF_OK)
+            return VF_EINPUT;
         o->every = (int)n;
         return VF_OK;
     case OPT_NO_WINDOW: o->reshoot.window = 0; return VF_OK;

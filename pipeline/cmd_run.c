@@ -85,10 +85,7 @@ static vf_status parse_options(int argc, char **argv, run_options *o)
             s = cli_count_int("--frames", optarg, 1, 100000, &o->run.ingest.capture.select.max_frames);
             break;
         case OPT_MINUTES:
-            if (cli_parse_doubles(optarg, &o->run.train.minutes, 1) != 1 ||
-                !(o->run.train.minutes > 0 && o->run.train.minutes <= 600))
-                s = vf_fail(VF_EINPUT, "--minutes must be a number above 0 (up to 600), not '%s'",
-                            optarg);
+            s = cli_number_above("--minutes", optarg, 0, 600, &o->run.train.minutes);
             break;
         case OPT_TRAIN_STEPS:
             s = cli_count_int("--train-steps", optarg, 1, 10000000, &o->run.train.steps);

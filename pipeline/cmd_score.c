@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "physical.h"
+#include "vf/csv.h"
 #include "vf/resources.h"
 #include "vf/score.h"
 
@@ -70,18 +71,18 @@ static vf_status parse(int argc, char **argv, score_options *o)
         if (handled)
             continue;
         if (c == OPT_TOLERANCE) {
-            if (cli_parse_doubles(optarg, &x, 1) != 1 || !(x > 0 && x <= 100))
-                return vf_fail(VF_EINPUT, "--tolerance: give a percentage in (0, 100], e.g. 5");
+            if (cli_number_above("--tolerance", optarg, 0, 100, &x) != VF_OK) /* percent */
+                return VF_EINPUT;
             o->score.tolerance = x / 100;
         } else if (c == OPT_TARGET) {
-            if (cli_parse_int(optarg, 0, 100000, &n))
-                return vf_fail(VF_EINPUT, "--target: give a target number (0 is v*)");
+            if (cli_count("--target", optarg, 0, 100000, &n) != VF_OK) /* 0 is v* */
+                return VF_EINPUT;
             o->score.target = (int)n;
         } else if (c == OPT_MODEL) {
             o->score.model = optarg;
         } else if (c == OPT_BLUR) {
-            if (cli_parse_doubles(optarg, &x, 1) != 1 || !(x >= 0 && x < 1))
-                return vf_fail(VF_EINPUT, "--blur-ratio: give a share in [0, 1), e.g. 0.3");
+            if (cli_number("--blur-ratio", optarg, 0, 0.99, &x) != VF_OK)
+                return VF_EINPUT;
             o->score.blur_ratio = x;
         } else if (c == OPT_SUMMARY) {
             o->summary = 1;
@@ -174,9 +175,14 @@ static void print_table(FILE *f, const json_t *rows, int csv)
         long long n = json_integer_value(json_object_get(r, "frames_used"));
         double lo = json_number_value(json_array_get(iv, 0));
         double hi = json_number_value(json_array_get(iv, 1));
-        fprintf(f, csv ? "\"%s\",\"%s\"" : "| %s | %s |",
-                json_string_value(json_object_get(r, "object")),
-                json_string_value(json_object_get(r, "label")));
+        const char *object = json_string_value(json_object_get(r, "object"));
+        const char *label = json_string_value(json_object_get(r, "label"));
+        if (csv) {
+            vf_csv_text(f, object);
+            vf_csv_next(f, label);
+        } else {
+            fprintf(f, "| %s | %s |", object, label);
+        }
         for (int j = 0; j < 6; j++) {
             double v = json_number_value(json_object_get(r, rate_keys[j]));
             if (csv && v >= 0)

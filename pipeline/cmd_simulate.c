@@ -1,6 +1,5 @@
 /* vfcapture simulate: the simulated studio (vf/studio.h). A person with a phone films a 3D
  * model in a room, or re-shoots it at an exported target; this parses and prints. */
-#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -10,7 +9,7 @@
 
 static const char usage[] =
     "usage: vfcapture simulate capture MODEL -o VIDEO.mp4 [options]\n"
-    "       vfcapture simulate reshoot WS --target N -o VIDEO.mp4 [--model MODEL] [options]\n"
+    "       vfcapture simulate reshoot WS --target N -o VIDEO.mp4 [--object MODEL] [options]\n"
     "       vfcapture simulate check WS VIDEO.mp4\n"
     "\n"
     "A simulated studio for the physical loop. Blender films the 3D model standing on a\n"
@@ -31,7 +30,7 @@ static const char usage[] =
     "                         reshoot: the capture's)\n"
     "      --fov DEG          vertical field of view (default 65; reshoot: the capture's)\n"
     "      --fps F            frames a second (default 30; reshoot: the capture's)\n"
-    "      --samples N        Cycles samples a pixel (default 8)\n"
+    "      --render-samples N Cycles samples a pixel (default 8)\n"
     "      --shake S          scale of hand shake (default 1; 0: a tripod)\n"
     "      --noise S          scale of sensor noise and exposure drift (default 1; 0: none)\n"
     "      --denoise H        the phone's denoising of each frame before encoding: non-local\n"
@@ -45,7 +44,7 @@ static const char usage[] =
     "      --distance D       camera distance in object radii (default 3.2)\n"
     "reshoot:\n"
     "      --target N         exported target (0 is v*)\n"
-    "      --model MODEL      the 3D model (default: the capture's)\n"
+    "      --object MODEL     the 3D model (default: the capture's)\n"
     "      --truth FILE       the capture's truth file (default: beside the ingested video)\n"
     "      --walk-seconds S   walking to the target (default 4)\n"
     "      --hold-seconds S   filming around it (default 6)\n"
@@ -65,7 +64,7 @@ enum {
     OPT_SIZE = CLI_OPT_FIRST_CUSTOM, OPT_FOV, OPT_FPS, OPT_SAMPLES, OPT_SHAKE, OPT_NOISE, OPT_DENOISE,
     OPT_SHUTTER, OPT_SEED, OPT_LOOPS, OPT_LOOP_SECONDS, OPT_ELEVATION, OPT_DISTANCE, OPT_TARGET,
     OPT_MODEL, OPT_TRUTH, OPT_WALK, OPT_HOLD, OPT_JITTER, OPT_FOLLOW, OPT_STARTS, OPT_GIVE_UP,
-    OPT_TOLERANCE
+    OPT_TOLERANCE, OPT_OLD_SAMPLES, OPT_OLD_MODEL
 };
 
 typedef struct simulate_options {
@@ -78,7 +77,6 @@ typedef struct simulate_options {
 
 static vf_status phone_option(int c, const char *arg, vf_studio_phone *p)
 {
-    long n;
     vf_status s = VF_OK;
     if (c == OPT_SIZE)
         s = cli_size("--size", arg, &p->width, &p->height);
@@ -86,8 +84,11 @@ static vf_status phone_option(int c, const char *arg, vf_studio_phone *p)
         s = cli_number("--fov", arg, 5, 170, &p->fov_y);
     else if (c == OPT_FPS)
         s = cli_number("--fps", arg, 1, 240, &p->fps);
-    else if (c == OPT_SAMPLES)
-        s = cli_count_int("--samples", arg, 1, 4096, &p->samples);
+    else if (c == OPT_SAMPLES || c == OPT_OLD_SAMPLES) {
+        if (c == OPT_OLD_SAMPLES) /* --samples is the attack's */
+            cli_deprecated("simulate", "--samples", "--render-samples");
+        s = cli_count_int("--render-samples", arg, 1, 4096, &p->samples);
+    }
     else if (c == OPT_SHAKE)
         s = cli_number("--shake", arg, 0, 10, &p->shake);
     else if (c == OPT_NOISE)
@@ -96,8 +97,8 @@ static vf_status phone_option(int c, const char *arg, vf_studio_phone *p)
         s = cli_number("--denoise", arg, 0, 50, &p->denoise);
     else if (c == OPT_SHUTTER)
         s = cli_number("--shutter", arg, 0, 1, &p->shutter);
-    else if (c == OPT_SEED && (s = cli_count("--seed", arg, 0, LONG_MAX, &n)) == VF_OK)
-        p->seed = (uint64_t)n;
+    else if (c == OPT_SEED)
+        s = cli_seed("--seed", arg, &p->seed);
     return s;
 }
 
@@ -109,7 +110,8 @@ static vf_status parse_options(int argc, char **argv, simulate_options *opt)
         {"size", required_argument, NULL, OPT_SIZE},
         {"fov", required_argument, NULL, OPT_FOV},
         {"fps", required_argument, NULL, OPT_FPS},
-        {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"render-samples", required_argument, NULL, OPT_SAMPLES},
+        {"samples", required_argument, NULL, OPT_OLD_SAMPLES},
         {"shake", required_argument, NULL, OPT_SHAKE},
         {"noise", required_argument, NULL, OPT_NOISE},
         {"denoise", required_argument, NULL, OPT_DENOISE},
@@ -120,7 +122,8 @@ static vf_status parse_options(int argc, char **argv, simulate_options *opt)
         {"elevation", required_argument, NULL, OPT_ELEVATION},
         {"distance", required_argument, NULL, OPT_DISTANCE},
         {"target", required_argument, NULL, OPT_TARGET},
-        {"model", required_argument, NULL, OPT_MODEL},
+        {"object", required_argument, NULL, OPT_MODEL},
+        {"model", required_argument, NULL, OPT_OLD_MODEL},
         {"truth", required_argument, NULL, OPT_TRUTH},
         {"walk-seconds", required_argument, NULL, OPT_WALK},
         {"hold-seconds", required_argument, NULL, OPT_HOLD},
@@ -162,7 +165,9 @@ static vf_status parse_options(int argc, char **argv, simulate_options *opt)
         else if (c == OPT_ELEVATION) {
             double e[2];
             if (cli_parse_doubles(optarg, e, 2) != 2 || !(e[0] > -10 && e[1] < 80))
-                s = vf_fail(VF_EINPUT, "--elevation wants LO,HI in degrees (-10 to 80), not '%s'",
+                s = vf_fail(VF_EINPUT,
+                            "--elevation wants LO,HI in degrees from -10 to 80, not "
+                            "'%s'",
                             optarg);
             cap->elevation_low = e[0], cap->elevation_high = e[1];
         } else if (c == OPT_DISTANCE)
@@ -170,8 +175,11 @@ static vf_status parse_options(int argc, char **argv, simulate_options *opt)
         else if (c == OPT_TARGET) {
             s = cli_count_int("--target", optarg, 0, 10000, &re->target);
             opt->target_given = 1;
-        } else if (c == OPT_MODEL)
+        } else if (c == OPT_MODEL || c == OPT_OLD_MODEL) {
+            if (c == OPT_OLD_MODEL) /* --model is the classifier everywhere else */
+                cli_deprecated("simulate", "--model", "--object");
             opt->model = optarg;
+        }
         else if (c == OPT_TRUTH)
             re->truth = optarg;
         else if (c == OPT_WALK)

@@ -25,11 +25,11 @@ static const char usage[] =
     "options:\n"
     "      --cores N          run on this machine with N cores (default: all)\n"
     "      --slurm            submit each job to Slurm (the profile in workflow/slurm/)\n"
-    "  -n, --dry-run          print the jobs that would run, run none\n"
+    "      --dry-run          print the jobs that would run, run none\n"
     "      --workflow DIR     the workflow folder (default $VF_WORKFLOW_DIR, else " VF_WORKFLOW_DIR
     ")\n" CLI_COMMON_HELP;
 
-enum { OPT_CORES = CLI_OPT_FIRST_CUSTOM, OPT_SLURM, OPT_WORKFLOW };
+enum { OPT_CORES = CLI_OPT_FIRST_CUSTOM, OPT_SLURM, OPT_WORKFLOW, OPT_DRY_RUN };
 
 int cmd_study(int argc, char **argv)
 {
@@ -37,7 +37,7 @@ int cmd_study(int argc, char **argv)
         CLI_COMMON_OPTIONS,
         {"cores", required_argument, NULL, OPT_CORES},
         {"slurm", no_argument, NULL, OPT_SLURM},
-        {"dry-run", no_argument, NULL, 'n'},
+        {"dry-run", no_argument, NULL, OPT_DRY_RUN},
         {"workflow", required_argument, NULL, OPT_WORKFLOW},
         {0, 0, 0, 0},
     };
@@ -53,14 +53,14 @@ int cmd_study(int argc, char **argv)
             extra = i + 1, argc = i;
             break;
         }
-    while (s == VF_OK && (c = getopt_long(argc, argv, CLI_COMMON_SHORT "n", longopts, NULL)) != -1) {
+    while (s == VF_OK && (c = getopt_long(argc, argv, CLI_COMMON_SHORT, longopts, NULL)) != -1) {
         if (cli_common_option(c, &flags, "study", usage))
             continue;
         if (c == OPT_CORES && (s = cli_count("--cores", optarg, 1, 4096, &n)) == VF_OK)
             cores = optarg;
         else if (c == OPT_SLURM)
             slurm = 1;
-        else if (c == 'n')
+        else if (c == OPT_DRY_RUN)
             dry = 1;
         else if (c == OPT_WORKFLOW)
             workflow = optarg;

@@ -5,7 +5,8 @@
 #include "vf/train.h"
 
 static const char usage[] =
-    "usage: vfcapture train WS [--minutes M | --steps N] [--holdout N] [--surroundings MODE]\n"
+    "usage: vfcapture train WS [--minutes M | --train-steps N] [--holdout N]\n"
+    "                      [--surroundings MODE]\n"
     "                      [--color MODEL] [--view-smoothing W] [--depth W] [--appearance]\n"
     "                      [--object-only] [--restart]\n"
     "\n"
@@ -17,7 +18,7 @@ static const char usage[] =
     "\n"
     "options:\n"
     "      --minutes M        training wall time (default 3; 5 for a 3D model's workspace)\n"
-    "      --steps N          train for N optimizer steps instead of a time (the same field\n"
+    "      --train-steps N    train for N optimizer steps instead of a time (the same field\n"
     "                         however busy the machine is)\n"
     "      --holdout N        hold out every Nth view for scoring, 0 for none (default 10)\n"
     "      --surroundings MODE  what lies beyond the box the cameras look at: auto (a coarser\n"
@@ -51,6 +52,7 @@ static const char usage[] =
 enum {
     OPT_MINUTES = CLI_OPT_FIRST_CUSTOM,
     OPT_STEPS,
+    OPT_TRAIN_STEPS,
     OPT_HOLDOUT,
     OPT_SURROUNDINGS,
     OPT_COLOR,
@@ -72,6 +74,7 @@ static vf_status parse_options(int argc, char **argv, cli_train *opt)
     static const struct option longopts[] = {
         CLI_COMMON_OPTIONS,
         {"minutes", required_argument, NULL, OPT_MINUTES},
+        {"train-steps", required_argument, NULL, OPT_TRAIN_STEPS},
         {"steps", required_argument, NULL, OPT_STEPS},
         {"holdout", required_argument, NULL, OPT_HOLDOUT},
         {"surroundings", required_argument, NULL, OPT_SURROUNDINGS},
@@ -89,19 +92,19 @@ static vf_status parse_options(int argc, char **argv, cli_train *opt)
         if (cli_common_option(c, &opt->flags, "train", usage))
             continue;
         if (c == OPT_MINUTES) {
-            if (cli_parse_doubles(optarg, &opt->train.minutes, 1) != 1 ||
-                !(opt->train.minutes > 0) || opt->train.minutes > 600)
-                return vf_fail(VF_EINPUT, "--minutes must be a number above 0 (up to 600), not "
-                                          "'%s'", optarg);
-        } else if (c == OPT_STEPS) {
-            if (cli_parse_int(optarg, 1, 10000000, &value) != 0)
-                return vf_fail(VF_EINPUT, "--steps must be a whole number from 1 up, not '%s'",
-                               optarg);
-            opt->train.steps = (int)value;
+            if (cli_number_above("--minutes", optarg, 0, 600, &opt->train.minutes) != VF_OK)
+                return VF_EINPUT;
+        } else if (c == OPT_STEPS || c == OPT_TRAIN_STEPS) {
+            if (c == OPT_STEPS)
+                cli_deprecated("train", "--steps", "--train-steps (--steps is the attack's)");
+            if (cli_count_int("--train-steps", optarg, 1, 10000000, &opt->train.steps) != VF_OK)
+                return VF_EINPUT;
         } else if (c == OPT_HOLDOUT) {
             if (cli_parse_int(optarg, 0, 1000000, &value) != 0 || value == 1)
-                return vf_fail(VF_EINPUT, "--holdout must be 0 or a whole number from 2 up, not "
-                                          "'%s'", optarg);
+                return vf_fail(VF_EINPUT,
+                               "--holdout wants 0 or a whole number from 2 to "
+                               "1000000, not '%s'",
+                               optarg);
             opt->train.holdout = (int)value;
         } else if (c == OPT_SURROUNDINGS) {
             int mode = vf_field_surroundings_parse(optarg);
@@ -116,15 +119,11 @@ static vf_status parse_options(int argc, char **argv, cli_train *opt)
                                optarg);
             opt->train.color = (vf_field_color)model;
         } else if (c == OPT_VIEW_SMOOTHING) {
-            if (cli_parse_doubles(optarg, &opt->train.view_smoothing, 1) != 1 ||
-                !(opt->train.view_smoothing >= 0 && opt->train.view_smoothing <= 1))
-                return vf_fail(VF_EINPUT, "--view-smoothing must be a number from 0 to 1, not "
-                                          "'%s'", optarg);
+            if (cli_number("--view-smoothing", optarg, 0, 1, &opt->train.view_smoothing) != VF_OK)
+                return VF_EINPUT;
         } else if (c == OPT_DEPTH) {
-            if (cli_parse_doubles(optarg, &opt->train.depth, 1) != 1 ||
-                !(opt->train.depth >= 0 && opt->train.depth <= 1000))
-                return vf_fail(VF_EINPUT, "--depth must be a number from 0 to 1000, not '%s'",
-                               optarg);
+            if (cli_number("--depth", optarg, 0, 1000, &opt->train.depth) != VF_OK)
+                return VF_EINPUT;
         } else if (c == OPT_APPEARANCE) {
             opt->train.appearance = 1;
         } else if (c == OPT_RESTART) {

@@ -9,7 +9,6 @@
 #include "vf/resources.h"
 #include "vf/transfer.h"
 
-#define MAX_MODELS 16
 
 static const char usage[] =
     "usage: vfcapture transfer WS --models A,B,... [--models-dir DIR] [--attack NAME] [--json]\n"
@@ -21,8 +20,8 @@ static const char usage[] =
     "for the attack NAME.\n"
     "\n"
     "options:\n"
-    "      --models A,B,...   model names (see vfcapture models) or .onnx paths; CNNs and\n"
-    "                         transformers may be mixed\n"
+    "      --models A,B,...   model names (see vfcapture models) or .onnx paths, or 'all' for\n"
+    "                         every model found; CNNs and transformers may be mixed\n"
     "      --models-dir DIR   look for model names here first\n" CLI_ATTACK_HELP CLI_ENGINE_HELP
         CLI_COMMON_HELP;
 
@@ -62,25 +61,6 @@ static vf_status parse_options(int argc, char **argv, transfer_options *opt)
     return VF_OK;
 }
 
-/* Resolve every model name first, so a typo fails before any work. */
-static vf_status find_models(const transfer_options *opt, char paths[][VF_PATH_MAX], int *count)
-{
-    char buf[4096];
-    if (snprintf(buf, sizeof buf, "%s", opt->models) >= (int)sizeof buf)
-        return vf_fail(VF_EINPUT, "--models is too long");
-    *count = 0;
-    char *save = NULL;
-    for (char *name = strtok_r(buf, ",", &save); name; name = strtok_r(NULL, ",", &save)) {
-        if (*count == MAX_MODELS)
-            return vf_fail(VF_EINPUT, "at most %d models at a time", MAX_MODELS);
-        vf_status s = vf_find_model(name, opt->models_dir, paths[*count], VF_PATH_MAX);
-        if (s != VF_OK)
-            return s;
-        (*count)++;
-    }
-    return *count ? VF_OK : vf_fail(VF_EINPUT, "--models names no model");
-}
-
 static void print_table(const json_t *rows)
 {
     printf("%-36s %5s %9s %10s %10s  %s\n", "model", "input", "natural", "ASR R(v*)",
@@ -103,11 +83,12 @@ static void print_table(const json_t *rows)
 
 static vf_status run(const transfer_options *opt)
 {
-    static char models[MAX_MODELS][VF_PATH_MAX];
-    char *paths[MAX_MODELS];
+    static char models[CLI_MAX_MODELS][VF_PATH_MAX];
+    char *paths[CLI_MAX_MODELS];
     int model_count = 0;
     json_t *doc = NULL;
-    vf_status s = find_models(opt, models, &model_count);
+    vf_status s = cli_models("--models", opt->models, opt->models_dir, models, CLI_MAX_MODELS,
+                             &model_count);
     for (int m = 0; m < model_count; m++)
         paths[m] = models[m];
     if (s == VF_OK)

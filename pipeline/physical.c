@@ -20,23 +20,23 @@ vf_status physical_localize_option(int opt, const char *arg, vf_localize_options
         lo->has_camera = 1;
         return vf_calib_load_camera(arg, &lo->camera);
     case PHYS_OPT_MIN_INLIERS:
-        if (cli_parse_int(arg, 6, 100000, &n))
-            return vf_fail(VF_EINPUT, "--min-inliers: give a number from 6 to 100000");
+        if (cli_count("--min-inliers", arg, 6, 100000, &n) != VF_OK)
+            return VF_EINPUT;
         lo->min_inliers = (int)n;
         return VF_OK;
     case PHYS_OPT_MIN_INLIER_RATIO:
-        if (cli_parse_doubles(arg, &x, 1) != 1 || !(x > 0 && x <= 1))
-            return vf_fail(VF_EINPUT, "--min-inlier-ratio: give a share in (0, 1], e.g. 0.2");
+        if (cli_number_above("--min-inlier-ratio", arg, 0, 1, &x) != VF_OK)
+            return VF_EINPUT;
         lo->min_inlier_ratio = x;
         return VF_OK;
     case PHYS_OPT_MAX_FEATURES:
-        if (cli_parse_int(arg, 100, 100000, &n))
-            return vf_fail(VF_EINPUT, "--max-features: give a number from 100 to 100000");
+        if (cli_count("--max-features", arg, 100, 100000, &n) != VF_OK)
+            return VF_EINPUT;
         lo->max_features = (int)n;
         return VF_OK;
     case PHYS_OPT_MAX_SIDE:
-        if (cli_parse_int(arg, 160, 100000, &n))
-            return vf_fail(VF_EINPUT, "--max-side: give a number of pixels from 160 up");
+        if (cli_count("--max-side", arg, 160, 100000, &n) != VF_OK)
+            return VF_EINPUT;
         lo->max_side = (int)n;
         return VF_OK;
     }

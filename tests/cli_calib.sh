@@ -57,7 +57,7 @@ one_line_naming "missing input" "nope.mp4"
 expect 1 "scale needs a method" -- "$tool" calib scale "$tmp/ws"
 one_line_naming "scale needs a method" "--marker"
 expect 1 "marker without size" -- "$tool" calib scale "$tmp/ws" --marker 3
-one_line_naming "marker without size" "--size"
+one_line_naming "marker without size" "--marker-size"
 expect 1 "distance needs three values" -- "$tool" calib scale "$tmp/ws" --distance 'a:1,2;b:3,4'
 one_line_naming "distance needs three values" "three values"
 ws="$tmp/ws"

@@ -13,7 +13,7 @@ models="$shared/data/models_3d"
 help_works ingest real
 grep -q "MODEL.glb" <("$tool" ingest --help) && ok || bad "ingest --help names 3D models"
 
-tiny=(--views 3 --test-views 1 --render-size 16 --samples 1 --quiet)
+tiny=(--views 3 --test-views 1 --render-size 16 --render-samples 1 --quiet)
 ws="$tmp/ws"
 expect 0 "a small capture of the bell pepper" -- \
   "$tool" ingest "$models/bell_pepper__yellow_bell_pepper.glb" -o "$ws" "${tiny[@]}"

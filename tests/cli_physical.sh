@@ -19,6 +19,12 @@ expect 1 "localize a text file" -- "$tool" localize "$tmp/ws" "$tmp/ws/manifest.
 one_line_naming "localize a text file" "neither an image"
 expect 1 "localize without poses" -- "$tool" localize "$tmp/ws" "$fox"
 one_line_naming "localize without poses" "run 'vfcapture poses"
+# A poses folder that the manifest does not mark complete (an interrupted poses, a copy) is
+# not read: the old localize read WS/poses/ by its folder alone.
+mkdir -p "$tmp/ws/poses/sparse" && : >"$tmp/ws/poses/sparse/cameras.txt"
+expect 1 "localize with a poses folder but no completed stage" -- "$tool" localize "$tmp/ws" "$fox"
+one_line_naming "localize with an unfinished poses" "has no poses yet: run 'vfcapture poses"
+rm -rf "$tmp/ws/poses"
 expect 1 "localize: bad --min-inliers" -- "$tool" localize "$tmp/ws" "$fox" --min-inliers 2
 one_line_naming "localize: bad --min-inliers" "min-inliers"
 

@@ -37,7 +37,7 @@ grep -q "poses is skipped: a posed set without a background" "$tmp/err" && ok \
 expect 0 "render a viewpoint" -- "$tool" render "$ws" --viewpoint 30,0,60,0,0,0 --size 128 -o "$tmp/view.png"
 [ -s "$tmp/view.png" ] && ok || bad "render wrote the image"
 expect 0 "render a pose" -- "$tool" render "$ws" --pose 1,0,0,0,0,1,0,0,0,0,1,4,0,0,0,1 -o "$tmp/pose.png" --quiet
-expect 0 "eval on the test views" -- "$tool" eval "$ws" --transforms "$chair/transforms_test.json" --out "$tmp/eval" --json
+expect 0 "eval on the test views" -- "$tool" eval "$ws" --transforms "$chair/transforms_test.json" -o "$tmp/eval" --json
 json_check "eval: 10 views, mean PSNR above 21 dB (white: 14.4)" 'd["views"] == 10 and d["psnr"] > 21 and len(d["per_view"]) == 10'
 [ -s "$tmp/eval/render_009.png" ] && [ -s "$tmp/eval/error_009.png" ] && ok || bad "eval --out saved renders and error images"
 

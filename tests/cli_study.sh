@@ -27,7 +27,7 @@ settings:
   nes-l0: --method nes --lambda 0
   random: --method random
 budgets:
-  train: --steps 200
+  train: --train-steps 200
   attack: --steps 1 --samples 4
 EOF
 }

@@ -174,7 +174,7 @@ static void test_camera_file(void)
         {"{\"fl_x\": 500, \"fl_y\": 500, \"cx\": 320, \"w\": 640, \"h\": 480}", "cy"},
         {"{\"fl_x\": 500, \"fl_y\": 500, \"cx\": 320, \"cy\": 240, \"w\": 640, \"h\": 480, "
          "\"k2\": 1e50}", "k2"},
-        {"[1, 2, 3]", "not a camera file"},
+        {"[1, 2, 3]", "not a camera"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         vf_write_file_atomic(path, bad[i][0], strlen(bad[i][0]));

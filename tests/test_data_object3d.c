@@ -93,14 +93,14 @@ int main(void)
     char ws[4096];
     snprintf(ws, sizeof ws, "%s/ws", dir);
     int rc = vf_test_system("'%s' ingest '%s' -o '%s' --views 24 --test-views 6 --render-size 100 "
-                            "--samples 16 --quiet",
+                            "--render-samples 16 --quiet",
                             tool(), vf_test_shared(MODEL), ws);
     CHECK(rc == 0, "ingest of the model (exit %d)", rc);
     if (rc != 0)
         return check_finish();
     check_capture(ws);
 
-    rc = vf_test_system("'%s' train '%s' --steps 600 --quiet && '%s' eval '%s' --transforms "
+    rc = vf_test_system("'%s' train '%s' --train-steps 600 --quiet && '%s' eval '%s' --transforms "
                         "'%s/ingest/transforms_test.json' --json > '%s/eval.json'",
                         tool(), ws, tool(), ws, ws, dir);
     CHECK(rc == 0, "train and eval (exit %d)", rc);
@@ -114,7 +114,7 @@ int main(void)
           "a model's field smooths its colour's direction terms (view_smoothing %g)",
           number(report, "view_smoothing", NULL));
     json_decref(report);
-    /* the budget a model's workspace gets when none is given (recorded even with --steps) */
+    /* the budget a model's workspace gets when none is given (recorded even with --train-steps) */
     json_t *manifest = load(ws, "manifest.json");
     const json_t *params = json_object_get(
         json_object_get(json_object_get(manifest, "stages"), "train"), "params");

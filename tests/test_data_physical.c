@@ -404,6 +404,37 @@ static int check_score(const char *ws, const char *video, double (*known)[16], i
     return kept;
 }
 
+/* `score` where no frame falls in the box (3 photos, a box of 0.01% of each range): no rate
+ * (the old code reported "0.0% ... 0/0"), one line saying so, exit 1, and the finished score
+ * of the whole video is kept. */
+static void check_score_no_frames(const char *ws, char names[][64], int n)
+{
+    char dir[VF_PATH_MAX], err[VF_PATH_MAX], path[2 * VF_PATH_MAX];
+    snprintf(dir, sizeof dir, "%s/three_photos", vf_test_tmpdir());
+    snprintf(err, sizeof err, "%s/score_none.err", vf_test_tmpdir());
+    int rc = vf_test_system("mkdir -p '%s' && cp '%s/%s' '%s/%s' '%s/%s' '%s/'", dir,
+                            vf_test_shared(FOX "/images"), names[0], vf_test_shared(FOX "/images"),
+                            names[n / 2], vf_test_shared(FOX "/images"), names[n - 1], dir);
+    CHECK(rc == 0, "made the three-photo folder");
+    rc = vf_test_system("'%s' score '%s' '%s' --tolerance 0.01 >/dev/null 2>'%s'", tool(), ws,
+                        dir, err);
+    char *text = NULL;
+    CHECK(rc == 1, "no frame in the box exits 1 (%d)", rc);
+    int lines = 0;
+    if (vf_read_file(err, &text, NULL) == VF_OK && text)
+        for (const char *c = text; *c; c++)
+            lines += *c == '\n';
+    CHECK(text && lines == 1 && strstr(text, "no measurement") && !strstr(text, "0.0%"),
+          "one line, no rate: %s", text ? text : "?");
+    free(text);
+    snprintf(path, sizeof path, "%s/score/score.json", ws);
+    json_t *doc = load_json(path);
+    CHECK((int)json_array_size(json_object_get(doc, "frames_detail")) == n,
+          "the score of the whole video is kept (%zu frames)",
+          json_array_size(json_object_get(doc, "frames_detail")));
+    json_decref(doc);
+}
+
 /* `export`: v* maps back to the COLMAP pose of its frame; CSV and shot card written. */
 static void check_export(const char *ws)
 {
@@ -528,6 +559,7 @@ int main(int argc, char **argv)
                             vf_test_shared(FOX "/images"), video);
     CHECK(rc == 0, "made the recapture video");
     int kept = check_score(ws, video, known, n, &v_star);
+    check_score_no_frames(ws, names, n);
     check_export(ws);
     check_reshoot(ws, video, kept);
     check_reshoot_stops(ws, video, kept);

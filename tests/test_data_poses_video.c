@@ -152,7 +152,7 @@ static void train_on_points(void)
     vf_path_join(path, sizeof path, ws, "train/report.json");
     const double weights[2] = {-1, 0}; /* the default, then off */
     for (int k = 0; k < 2; k++) {
-        snprintf(args, sizeof args, "train '%s' --steps 30 --holdout 0 --restart --quiet%s", ws,
+        snprintf(args, sizeof args, "train '%s' --train-steps 30 --holdout 0 --restart --quiet%s", ws,
                  k ? " --depth 0" : "");
         CHECK(run_tool(args) == 0, "train (%s) exit 0 (stderr in %s/err.txt)",
               k ? "--depth 0" : "default", tmp);

@@ -40,7 +40,7 @@
 #define MODEL "data/models_3d/water_bottle__WaterBottle.glb"
 #define FPS 15
 #define LOOP_SECONDS 2 /* two loops: 60 frames, of which ingest keeps 50 */
-#define PHONE "--samples 4 --denoise 10" /* every render: see the poses above */
+#define PHONE "--render-samples 4 --denoise 10" /* every render: see the poses above */
 #define TOLERANCE 0.15 /* score's box: +-15% of each parameter's range; the person wanders
                           * 3% around v* and the hand shakes the position by 1% of the
                           * distance: most frames on target are well inside */

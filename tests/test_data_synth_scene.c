@@ -648,7 +648,11 @@ static void test_localize(void)
     vf_localize_options opt;
     vf_localize_defaults(&opt);
     vf_localizer *loc = NULL;
-    vf_status s = vf_localizer_open(posed.ws, &opt, &loc);
+    vf_workspace ws = {0};
+    vf_status s = vf_workspace_open(posed.ws, 0, &ws);
+    if (s == VF_OK)
+        s = vf_localizer_open(&ws, &opt, &loc);
+    vf_workspace_close(&ws);
     CHECK(s == VF_OK, "localizer: %s", vf_error_message());
     if (s != VF_OK)
         return;

@@ -954,6 +954,19 @@ static void test_checkpoint_resume(void)
               strstr(vf_error_message(), "budget of 40 steps"),
           "a new budget on resume refused: %s", vf_error_message());
     vf_field_trainer_free(other);
+
+    /* other loss weights: refused naming each (the old check compared the budget, the
+     * surroundings and the colour model only, and kept the checkpoint's weights silently) */
+    opt.steps = 40;
+    vf_field_train_options asked = opt;
+    asked.depth = 0, asked.tv_view = 1e-4f, asked.appearance = 1e-3f;
+    vf_field_trainer_create(&asked, &other);
+    add_views(other, truth, 12);
+    const char *message = vf_field_trainer_resume(other, ckpt) == VF_EINPUT ? vf_error_message() : "";
+    CHECK(strstr(message, "--depth") && strstr(message, "--view-smoothing") &&
+              strstr(message, "--appearance") && !strstr(message, "budget"),
+          "other loss weights on resume refused, each named: %s", message);
+    vf_field_trainer_free(other);
     vf_field_trainer_free(r);
     vf_field_trainer_free(t);
     vf_field_free(truth);

@@ -184,6 +184,16 @@ static void test_attack_file(void)
     CHECK(a.has_camera && a.camera.width == 224, "camera");
     CHECK(isnan(a.natural_accuracy) && a.asr_v_star == 1.0, "rates");
     vf_attack_file_free(&a);
+    /* The camera is read like a camera file (vf_camera_from_json, one set of bounds): one out
+     * of them is refused naming it (the old reader dropped it silently and kept going). */
+    doc = NULL;
+    CHECK(vf_json_load(path, &doc) == VF_OK, "reload");
+    json_object_set_new(json_object_get(doc, "camera"), "w", json_integer(200000));
+    vf_json_save(path, doc);
+    json_decref(doc);
+    CHECK(vf_attack_file_load(path, &a) == VF_EINPUT && strstr(vf_error_message(), "camera") &&
+              strstr(vf_error_message(), "100000"),
+          "a camera out of bounds is refused: %s", vf_error_message());
     doc = json_pack("{s:[f,f]}", "v_star", 1.0, 2.0);
     vf_json_save(path, doc);
     json_decref(doc);

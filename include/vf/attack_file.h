@@ -2,7 +2,7 @@
  *
  * The attack stage (vf/attack.h) writes it with vf_attack_file_json; export, reshoot, score,
  * transfer, real and the ImageNet-V style set read it with vf_attack_file_load. Keys (all
- * viewpoints are 6 numbers psi, theta, phi in degrees, dx, dy, dz in scene units, DESIGN.md):
+ * viewpoints are 6 numbers psi, theta, phi in degrees, dx, dy, dz in scene units, ../shared/DESIGN.md):
  *
  *   "v_star", "v_star_prediction", "asr_v_star"     v* and the classifier's answer there
  *   "v_best", "v_best_prediction", "asr_v_best"     the best sample of the last step

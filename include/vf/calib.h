@@ -2,7 +2,7 @@
  * workspace.
  *
  * Intrinsics: frames that show a planar checkerboard (or ChArUco board) of known square size
- * are searched for its inner corners (OpenCV, src/opencv/calib_cv.cpp and charuco_cv.cpp);
+ * are searched for its inner corners (OpenCV, calib/calib_cv.cpp and calib/charuco_cv.cpp);
  * well-spread views are kept; OpenCV's calibrateCamera gives the first estimate of the OPENCV
  * lens (fx, fy, cx, cy, k1, k2, p1, p2, as COLMAP and vf/camera.h use it); views that
  * reproject badly are dropped; Ceres then refines lens and board poses together under a robust

@@ -8,6 +8,10 @@
 #ifndef VF_CAMERA_H
 #define VF_CAMERA_H
 
+#include <jansson.h>
+
+#include "vf/error.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -40,6 +44,26 @@ int vf_camera_project(const vf_camera *cam, const double p_cam[3], double *u, do
 
 /* The unit ray through pixel (u, v), in OpenCV camera axes (distortion removed). */
 void vf_camera_pixel_ray(const vf_camera *cam, double u, double v, double dir[3]);
+
+/* ---- the camera as JSON: one format and one set of bounds for every file that holds one
+ * (camera files from `calib`, attack.json, the intrinsics of transforms files) ---- */
+
+/* The bounds every camera read from a file must meet: whole sizes from 1 to
+ * VF_CAMERA_MAX_SIDE, focal lengths above 0 and below VF_CAMERA_MAX_PIXELS, principal point
+ * within +-VF_CAMERA_MAX_PIXELS, distortion terms within +-VF_CAMERA_MAX_DISTORTION (all
+ * bounds exclusive). */
+#define VF_CAMERA_MAX_SIDE 100000
+#define VF_CAMERA_MAX_PIXELS 1e7
+#define VF_CAMERA_MAX_DISTORTION 100
+/* VF_OK, or VF_EINPUT naming the first value out of those bounds. */
+vf_status vf_camera_check(const vf_camera *cam);
+
+/* {"fl_x", "fl_y", "cx", "cy", "w", "h", "k1", "k2", "p1", "p2"} (a new reference). */
+json_t *vf_camera_json(const vf_camera *cam);
+/* Read those keys from a JSON object (fx, fy, width and height are accepted for the first
+ * ones; the distortion terms are optional, 0 when absent) and check the bounds. VF_EINPUT
+ * "WHERE: ..." naming the key. */
+vf_status vf_camera_from_json(const json_t *obj, const char *where, vf_camera *cam);
 
 #ifdef __cplusplus
 }

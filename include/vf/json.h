@@ -22,6 +22,11 @@ extern "C" {
 vf_status vf_json_save(const char *path, const json_t *doc);
 /* Load a JSON document; errors name the file and the line. */
 vf_status vf_json_load(const char *path, json_t **out);
+/* A number (a new reference); inf and nan as null. JSON has no inf or nan, and jansson's
+ * json_real gives NULL for them, which makes a whole json_pack document NULL: so every double
+ * the project writes goes through here (in json_pack as "o" with vf_json_number(x), never "f").
+ * Readers take null as "not measured". */
+json_t *vf_json_number(double x);
 /* n numbers as a JSON array (a new reference); inf and nan as null. */
 json_t *vf_json_doubles(const double *x, int n);
 /* A 4x4 row-major matrix as four rows of four numbers (a new reference). */

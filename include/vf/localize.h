@@ -31,6 +31,7 @@
 #include "vf/pose.h"
 #include "vf/rgb8.h"
 #include "vf/sfm_export.h"
+#include "vf/workspace.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -67,9 +68,10 @@ typedef struct vf_localize_result {
 
 typedef struct vf_localizer vf_localizer;
 
-/* Load the map of workspace `ws_root` (WS/poses/sparse, database.db, normalization.json).
- * VF_EINPUT naming what is missing (run `vfcapture poses` first) or inconsistent. */
-vf_status vf_localizer_open(const char *ws_root, const vf_localize_options *opt,
+/* Load the map of a workspace (WS/poses/sparse, database.db, normalization.json). VF_EINPUT
+ * when its poses stage is not complete and current (vf_workspace_need: run `vfcapture poses`
+ * first) or its files are missing or inconsistent. */
+vf_status vf_localizer_open(const vf_workspace *ws, const vf_localize_options *opt,
                             vf_localizer **out);
 void vf_localizer_close(vf_localizer *loc);
 

@@ -1,4 +1,4 @@
-/* vf/normalize.h: the object frame of a reconstructed scene (DESIGN.md, coordinate frames).
+/* vf/normalize.h: the object frame of a reconstructed scene (../shared/DESIGN.md, coordinate frames).
  *
  * Structure from motion returns cameras in an arbitrary frame and scale. The object frame puts
  * the object at the origin with z up and the cameras at a mean distance of 4

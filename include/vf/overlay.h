@@ -1,5 +1,5 @@
 /* vf/overlay.h: a live window for guided capture: camera frames with lines of text drawn over
- * them (OpenCV highgui, src/opencv/overlay_cv.cpp). Opened only where a display exists; the
+ * them (OpenCV highgui, src/physical/overlay_cv.cpp). Opened only where a display exists; the
  * drawing itself works anywhere (and is what the tests check).
  *
  * Memory: vf_overlay_draw fills `out` (reused); a window is released with vf_overlay_close. */

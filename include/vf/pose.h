@@ -16,7 +16,7 @@
  *   - Angles are radians, except the viewpoint and vf_rot_angle_deg (degrees).
  *   - Axis-angle is a rotation vector: unit axis times angle (radians).
  *
- * The viewpoint (DESIGN.md, "Method"), object frame z up, object at the origin:
+ * The viewpoint (../shared/DESIGN.md, "Method"), object frame z up, object at the origin:
  *     c2w(v) = Rz(psi) * Ry(-theta) * Rx(phi - 90deg) * T(dx, dz, 4 + dy)
  * The camera rotation is R = Rz Ry Rx and its position R (dx, dz, 4 + dy). Note that dz sits
  * in the camera's y slot (camera up) and dy in the z slot (distance). What the formula does,

@@ -45,6 +45,11 @@ void vf_score_defaults(vf_score_options *o);
 vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
                        const vf_score_options *o, json_t **result);
 
+/* WS/score/score.json of a completed score stage (the one reader of the file; a new reference
+ * in *doc). VF_EINPUT "WS has no score yet: run ..." without one, or naming the file when it
+ * lacks what score writes (center_viewpoint, tolerance_percent, kept, frames_detail). */
+vf_status vf_score_load(const vf_workspace *ws, json_t **doc);
+
 /* One row per workspace for a table across objects: {"object", "label", "natural_accuracy",
  * "asr_v_star", "asr_samples" (the attack's renders), "real_natural_accuracy",
  * "real_asr_v_star", "real_asr_samples" (the object itself, for a 3D model's `real`), and

@@ -15,6 +15,7 @@
 #include "vf/colmap_model.h"
 #include "vf/dataset.h"
 #include "vf/normalize.h"
+#include "vf/workspace.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -42,6 +43,12 @@ vf_status vf_sfm_save_normalization(const char *path, const vf_normalization *no
  * similarity is not one (scale 1e-9..1e9, an orthonormal rotation with det +1). */
 vf_status vf_normalization_load(const char *path, vf_similarity *object_from_colmap,
                                 vf_similarity *colmap_from_object);
+/* The same from a workspace's poses stage (WS/poses/normalization.json, the one place its path
+ * is made). *found is 0, and VF_OK, when the stage has no such file (a posed set imported
+ * without COLMAP's frame); found NULL makes that VF_EINPUT naming the file. */
+vf_status vf_normalization_load_workspace(const vf_workspace *ws,
+                                          vf_similarity *object_from_colmap,
+                                          vf_similarity *colmap_from_object, int *found);
 
 #ifdef __cplusplus
 }

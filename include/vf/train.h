@@ -24,6 +24,7 @@
 #include <jansson.h>
 
 #include "vf/error.h"
+#include "vf/dataset.h"
 #include "vf/field.h"
 #include "vf/workspace.h"
 
@@ -78,6 +79,27 @@ vf_status vf_train_options_check(const vf_train_options *o);
 /* Train on an open workspace. *result (may be NULL) gets report.json's document (a new
  * reference). VF_EINPUT when there are fewer than 3 training views. */
 vf_status vf_train_run(vf_workspace *ws, const vf_train_options *o, json_t **result);
+
+/* Scoring a field against posed photos: the held-out views of `train` and the test sets of
+ * `eval` go through the same loop. Each chosen photo is rendered at its pose and compared. */
+typedef struct vf_photo_scoring {
+    int holdout;            /* score frames i with i % holdout == holdout / 2 (train's held-out
+                               views); 0: every frame */
+    int object_cut;         /* cut each photo by the field's silhouette first (object mode) */
+    const char *sheet_path; /* NULL, or a contact sheet of the first photo | render pairs */
+    const char *save_dir;   /* NULL, or DIR/render_NNN.png and DIR/error_NNN.png per view */
+} vf_photo_scoring;
+
+typedef struct vf_photo_scores {
+    int count;                /* views scored */
+    double psnr, ssim;        /* means (NAN without views) */
+    double psnr_object;       /* mean PSNR inside the photos' masks: photos with alpha, or
+                                 cut in object mode (else NAN) */
+} vf_photo_scores;
+
+/* Score; `list` (a JSON array) gets {"image", "psnr", "ssim"} per view. Shows progress. */
+vf_status vf_field_score_photos(const vf_field *f, const vf_dataset *views,
+                                const vf_photo_scoring *how, json_t *list, vf_photo_scores *out);
 
 #ifdef __cplusplus
 }

@@ -1,7 +1,7 @@
 /* vf/video.h: reading video files frame by frame, upright.
  *
  * Anything FFmpeg decodes (MP4/MOV/MKV with H.264, HEVC, ...) is read through OpenCV's FFmpeg
- * backend (src/opencv/video_cv.cpp). Phone videos are usually stored sideways with a rotation
+ * backend (src/capture/video_cv.cpp). Phone videos are usually stored sideways with a rotation
  * in the container's display matrix; frames come out rotated as a player would show them.
  * (OpenCV 4.6's own CAP_PROP_ORIENTATION_AUTO turns +-90 degree videos the wrong way, see
  * opencv/opencv#22088, so the reader applies the rotation itself.)

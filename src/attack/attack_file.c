@@ -1,5 +1,6 @@
 /* WS/attack/attack.json, written and read (vf/attack_file.h). */
 #include "vf/attack_file.h"
+#include "vf/json.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -48,17 +49,16 @@ static json_t *eval_json(const vf_attack_eval *ev)
         r[i] = i + 1;
     vf_view_ranges_paper(range);
     return json_pack(
-        "{s:o, s:o, s:f, s:o, s:o, s:f, s:o, s:o, s:o, s:f, s:o, s:{s:o, s:o, s:i}, s:o}",
-        "v_star", vf_json_doubles(ev->v_star, VF_VIEW_DIM), "v_star_prediction",
-        vf_view_prediction_to_json(&ev->v_star_pred), "asr_v_star", ev->asr_v_star, "v_best",
-        vf_json_doubles(ev->v_best, VF_VIEW_DIM), "v_best_prediction",
-        vf_view_prediction_to_json(&ev->v_best_pred), "asr_v_best", ev->asr_v_best,
+        "{s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:{s:o, s:o, s:i}, s:o}", "v_star",
+        vf_json_doubles(ev->v_star, VF_VIEW_DIM), "v_star_prediction",
+        vf_view_prediction_to_json(&ev->v_star_pred), "asr_v_star", vf_json_number(ev->asr_v_star),
+        "v_best", vf_json_doubles(ev->v_best, VF_VIEW_DIM), "v_best_prediction",
+        vf_view_prediction_to_json(&ev->v_best_pred), "asr_v_best", vf_json_number(ev->asr_v_best),
         "measure_ranges", vf_json_doubles(range, VF_VIEW_DIM), "samples", samples,
-        "sample_predictions", preds, "asr_samples", ev->asr_samples, "sample_std",
+        "sample_predictions", preds, "asr_samples", vf_json_number(ev->asr_samples), "sample_std",
         vf_json_doubles(ev->sample_std, VF_VIEW_DIM), "fluctuation", "r_percent",
-        vf_json_doubles(r, VF_FLUCT_LEVELS), "asr",
-        vf_json_doubles(ev->fluct_asr, VF_FLUCT_LEVELS), "samples_per_level", VF_FLUCT_SAMPLES,
-        "top_wrong_classes", wrong);
+        vf_json_doubles(r, VF_FLUCT_LEVELS), "asr", vf_json_doubles(ev->fluct_asr, VF_FLUCT_LEVELS),
+        "samples_per_level", VF_FLUCT_SAMPLES, "top_wrong_classes", wrong);
 }
 
 /* The distribution and the optimizer's history ("mu" ... "batch_asr_per_step"). */
@@ -78,10 +78,10 @@ static void add_distribution(json_t *doc, const vf_attack_state *st, const vf_at
             json_array_append_new(views, vf_json_doubles(v, VF_VIEW_DIM));
         }
         for (int s = 0; s < st->step; s++) {
-            json_array_append_new(loss, json_real(st->history[s].mean_loss));
-            json_array_append_new(max_loss, json_real(st->history[s].max_loss));
-            json_array_append_new(entropy, json_real(st->history[s].entropy));
-            json_array_append_new(asr, json_real(st->history[s].fooled_rate));
+            json_array_append_new(loss, vf_json_number(st->history[s].mean_loss));
+            json_array_append_new(max_loss, vf_json_number(st->history[s].max_loss));
+            json_array_append_new(entropy, vf_json_number(st->history[s].entropy));
+            json_array_append_new(asr, vf_json_number(st->history[s].fooled_rate));
         }
     }
     /* One component: mu and sigma are plain 6-vectors; a mixture: one row per component. */
@@ -115,27 +115,27 @@ json_t *vf_attack_file_json(const vf_attack_outcome *o)
     json_object_set_new(doc, "method", json_string(o->method));
     json_object_set_new(doc, "space", json_string(o->space));
     json_object_set_new(doc, "bounds", bounds_json(o));
-    json_object_set_new(doc, "camera",
-                        json_pack("{s:f, s:f, s:f, s:f, s:i, s:i}", "fl_x", cam->fx, "fl_y",
-                                  cam->fy, "cx", cam->cx, "cy", cam->cy, "w", cam->width, "h",
-                                  cam->height));
-    json_object_set_new(doc, "natural_accuracy", json_real(o->natural_accuracy));
+    json_object_set_new(doc, "camera", vf_camera_json(cam));
+    json_object_set_new(doc, "natural_accuracy", vf_json_number(o->natural_accuracy));
     json_object_set_new(doc, "natural_views", json_integer(o->natural_views));
     json_object_set_new(doc, "config", vf_attack_config_to_json(o->cfg));
     add_distribution(doc, o->st, o->cfg);
     if (o->baseline)
-        json_object_set_new(
-            doc, "random_search",
-            json_pack("{s:f, s:o, s:f, s:i}", "asr_samples", o->baseline->asr, "best_view",
-                      vf_json_doubles(o->baseline->best_view, VF_VIEW_DIM), "best_loss",
-                      o->baseline->best_loss, "samples", VF_EVAL_SAMPLES));
+        json_object_set_new(doc, "random_search",
+                            json_pack("{s:o, s:o, s:o, s:i}", "asr_samples",
+                                      vf_json_number(o->baseline->asr), "best_view",
+                                      vf_json_doubles(o->baseline->best_view, VF_VIEW_DIM),
+                                      "best_loss", vf_json_number(o->baseline->best_loss),
+                                      "samples", VF_EVAL_SAMPLES));
     json_object_set_new(
         doc, "timings",
-        json_pack("{s:f, s:f, s:f, s:f, s:i, s:f, s:f}", "natural_seconds", o->seconds_natural,
-                  "attack_seconds", o->seconds_attack, "evaluation_seconds", o->seconds_eval,
-                  "baseline_seconds", o->seconds_baseline, "views", (json_int_t)o->stats.views,
-                  "render_ms_per_view", 1000 * o->stats.render_seconds / views,
-                  "classify_ms_per_view", 1000 * o->stats.classify_seconds / views));
+        json_pack(
+            "{s:o, s:o, s:o, s:o, s:i, s:o, s:o}", "natural_seconds",
+            vf_json_number(o->seconds_natural), "attack_seconds", vf_json_number(o->seconds_attack),
+            "evaluation_seconds", vf_json_number(o->seconds_eval), "baseline_seconds",
+            vf_json_number(o->seconds_baseline), "views", (json_int_t)o->stats.views,
+            "render_ms_per_view", vf_json_number(1000 * o->stats.render_seconds / views),
+            "classify_ms_per_view", vf_json_number(1000 * o->stats.classify_seconds / views)));
     return doc;
 }
 
@@ -194,19 +194,17 @@ static vf_status read_labels(const json_t *doc, const char *path, vf_attack_file
     return VF_OK;
 }
 
-static void read_camera(const json_t *doc, vf_attack_file *a)
+/* The classifier's camera the attack rendered with (optional: older files have none). */
+static vf_status read_camera(const json_t *doc, const char *path, vf_attack_file *a)
 {
     const json_t *c = json_object_get(doc, "camera");
-    double fx = number_or_nan(c, "fl_x"), fy = number_or_nan(c, "fl_y");
-    double cx = number_or_nan(c, "cx"), cy = number_or_nan(c, "cy");
-    double w = number_or_nan(c, "w"), h = number_or_nan(c, "h");
-    /* an export renders previews with this camera: keep it to a sane size */
-    if (fx > 0 && fy > 0 && cx > 0 && cy > 0 && fx < 1e6 && fy < 1e6 && cx < 1e5 && cy < 1e5 &&
-        w >= 1 && h >= 1 && w <= 8192 && h <= 8192) {
-        a->has_camera = 1;
-        a->camera =
-            (vf_camera){.width = (int)w, .height = (int)h, .fx = fx, .fy = fy, .cx = cx, .cy = cy};
-    }
+    if (!c)
+        return VF_OK;
+    char where[VF_PATH_MAX + 16];
+    snprintf(where, sizeof where, "%s: \"camera\"", path);
+    vf_status status = vf_camera_from_json(c, where, &a->camera);
+    a->has_camera = status == VF_OK;
+    return status;
 }
 
 /* "measure_ranges", or the paper's full ranges for files written before it existed. */
@@ -322,7 +320,7 @@ vf_status vf_attack_file_load(const char *path, vf_attack_file *out)
         out->natural_accuracy = number_or_nan(doc, "natural_accuracy");
         out->asr_v_star = number_or_nan(doc, "asr_v_star");
         out->asr_samples = number_or_nan(doc, "asr_samples");
-        read_camera(doc, out);
+        status = read_camera(doc, path, out);
     }
     json_decref(doc);
     if (status != VF_OK)

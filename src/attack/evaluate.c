@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "vf/classifier.h"
+#include "vf/json.h"
 
 /* Stream offsets so the evaluation never reuses the optimizer's random numbers. */
 #define SAMPLE_STREAM 0x5a3c1e77d2b4f601ULL
@@ -99,7 +100,8 @@ vf_status vf_attack_eval_random(vf_view_loss *vl, const vf_view_bounds *bounds, 
 
 json_t *vf_view_prediction_to_json(const vf_view_prediction *p)
 {
-    return json_pack("{s:i, s:s, s:f, s:f, s:b}", "class", p->top_class, "name",
-                     vf_class_short_name(p->top_class), "confidence", (double)p->top_prob,
-                     "label_probability", (double)p->label_prob, "fooled", !p->correct);
+    return json_pack("{s:i, s:s, s:o, s:o, s:b}", "class", p->top_class, "name",
+                     vf_class_short_name(p->top_class), "confidence",
+                     vf_json_number((double)p->top_prob), "label_probability",
+                     vf_json_number((double)p->label_prob), "fooled", !p->correct);
 }

@@ -12,6 +12,7 @@
 #include "vf/classifier.h"
 #include "vf/dataset.h"
 #include "vf/field.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/resources.h"
 #include "vf/view_coverage.h"
@@ -285,9 +286,9 @@ static vf_status save_checkpoint(const attack_run *run, const vf_attack_state *s
     vf_status s = vf_path_join(path, sizeof path, run->stage.dir, CHECKPOINT);
     if (s != VF_OK)
         return s;
-    json_t *doc = json_pack("{s:i, s:o, s:o, s:f}", "format", CHECKPOINT_FORMAT, "setup",
+    json_t *doc = json_pack("{s:i, s:o, s:o, s:o}", "format", CHECKPOINT_FORMAT, "setup",
                             setup_json(run), "state", vf_attack_state_to_json(st), "seconds",
-                            run->resumed_seconds + vf_now() - run->attack_start);
+                            vf_json_number(run->resumed_seconds + vf_now() - run->attack_start));
     s = vf_json_save(path, doc);
     json_decref(doc);
     return s;
@@ -425,8 +426,10 @@ static vf_status attack_and_report(attack_run *run, json_t **result)
                       vf_attack_search_name(run->opt->method),
                       "space", vf_view_space_name(run->opt->space), "config",
                       json_object_get(doc, "config"), "label", json_object_get(doc, "label"));
-        json_t *summary = json_pack("{s:f, s:f, s:f}", "natural_accuracy", run->natural_accuracy,
-                                    "asr_v_star", ev->asr_v_star, "asr_samples", ev->asr_samples);
+        json_t *summary =
+            json_pack("{s:o, s:o, s:o}", "natural_accuracy", vf_json_number(run->natural_accuracy),
+                      "asr_v_star", vf_json_number(ev->asr_v_star), "asr_samples",
+                      vf_json_number(ev->asr_samples));
         s = vf_stage_commit(&run->stage, params, summary);
     }
     /* the checkpoint goes once the stage is in place (a failed commit keeps it for resume) */

@@ -8,6 +8,7 @@
 #include "vf/classifier.h"
 #include "vf/dataset.h"
 #include "vf/field.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/resources.h"
 #include "vf/view_loss.h"
@@ -48,11 +49,12 @@ static vf_status measure_model(const char *model, const vf_field *field, const d
         s = vf_view_loss_classify(vl, v_star, 1, &star, NULL);
     }
     if (s == VF_OK)
-        *row = json_pack("{s:s, s:s, s:i, s:f, s:f, s:f, s:o}", "model", model, "engine",
-                         vf_classifier_engine(cls), "input_size",
-                         vf_classifier_input_size(cls), "natural_accuracy", natural, "asr_samples",
-                         asr, "asr_v_star", star.correct ? 0.0 : 1.0, "v_star_prediction",
-                         vf_view_prediction_to_json(&star));
+        *row =
+            json_pack("{s:s, s:s, s:i, s:o, s:o, s:o, s:o}", "model", model, "engine",
+                      vf_classifier_engine(cls), "input_size", vf_classifier_input_size(cls),
+                      "natural_accuracy", vf_json_number(natural), "asr_samples",
+                      vf_json_number(asr), "asr_v_star", vf_json_number(star.correct ? 0.0 : 1.0),
+                      "v_star_prediction", vf_view_prediction_to_json(&star));
     vf_view_loss_free(vl);
     vf_classifier_close(cls);
     free(pred);

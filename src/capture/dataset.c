@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "vf/image.h"
+#include "vf/json.h"
 #include "vf/workspace.h"
 
 /* Intrinsics as a transforms file states them: any field may be missing (NAN / 0). */
@@ -21,15 +22,15 @@ static double number_or(const json_t *obj, const char *key, double fallback)
     return json_is_number(v) ? json_number_value(v) : fallback;
 }
 
-/* An image size: a whole number from 1 to 100000, else -1 (refused later); fallback when
- * absent. Never a cast of an arbitrary double to int. */
+/* An image size: a whole number from 1 to VF_CAMERA_MAX_SIDE, else -1 (refused later);
+ * fallback when absent. Never a cast of an arbitrary double to int. */
 static int size_or(const json_t *obj, const char *key, int fallback)
 {
     const json_t *v = json_object_get(obj, key);
     if (!v)
         return fallback;
     double x = json_is_number(v) ? json_number_value(v) : NAN;
-    return x >= 1 && x <= 100000 && x == floor(x) ? (int)x : -1;
+    return x >= 1 && x <= VF_CAMERA_MAX_SIDE && x == floor(x) ? (int)x : -1;
 }
 
 /* Fields in `obj` override those already in `in` (top level first, then per frame). */
@@ -53,7 +54,8 @@ static void read_intrinsics(const json_t *obj, stated_intrinsics *in)
 static vf_status resolve_camera(const stated_intrinsics *in, int img_w, int img_h, vf_camera *cam)
 {
     if (in->w < 0 || in->h < 0)
-        return vf_fail(VF_EINPUT, "w and h must be whole numbers of pixels from 1 to 100000");
+        return vf_fail(VF_EINPUT, "w and h must be whole numbers of pixels from 1 to %d",
+                       VF_CAMERA_MAX_SIDE);
     int w = in->w > 0 ? in->w : img_w, h = in->h > 0 ? in->h : img_h;
     memset(cam, 0, sizeof *cam);
     cam->width = w;
@@ -72,11 +74,9 @@ static vf_status resolve_camera(const stated_intrinsics *in, int img_w, int img_
     cam->k2 = in->k2;
     cam->p1 = in->p1;
     cam->p2 = in->p2;
-    if (!(cam->fx < 1e7 && cam->fy < 1e7 && fabs(cam->cx) < 1e7 && fabs(cam->cy) < 1e7 &&
-          fabs(cam->k1) <= 100 && fabs(cam->k2) <= 100 && fabs(cam->p1) <= 100 &&
-          fabs(cam->p2) <= 100))
-        return vf_fail(VF_EINPUT, "the camera's focal length, principal point or distortion is "
-                       "out of range");
+    vf_status status = vf_camera_check(cam);
+    if (status != VF_OK)
+        return status;
     if (w != img_w || h != img_h) {
         double sx = (double)img_w / w, sy = (double)img_h / h;
         if (fabs(sx - sy) > 0.01 * sx)
@@ -181,17 +181,8 @@ vf_status vf_dataset_load(const char *transforms_path, vf_dataset *out)
 
 static void write_intrinsics(json_t *obj, const vf_camera *c)
 {
-    json_object_set_new(obj, "camera_angle_x", json_real(2.0 * atan(0.5 * c->width / c->fx)));
-    json_object_set_new(obj, "fl_x", json_real(c->fx));
-    json_object_set_new(obj, "fl_y", json_real(c->fy));
-    json_object_set_new(obj, "cx", json_real(c->cx));
-    json_object_set_new(obj, "cy", json_real(c->cy));
-    json_object_set_new(obj, "w", json_integer(c->width));
-    json_object_set_new(obj, "h", json_integer(c->height));
-    json_object_set_new(obj, "k1", json_real(c->k1));
-    json_object_set_new(obj, "k2", json_real(c->k2));
-    json_object_set_new(obj, "p1", json_real(c->p1));
-    json_object_set_new(obj, "p2", json_real(c->p2));
+    json_object_set_new(obj, "camera_angle_x", vf_json_number(2.0 * atan(0.5 * c->width / c->fx)));
+    json_object_update_new(obj, vf_camera_json(c));
 }
 
 vf_status vf_dataset_save(const char *transforms_path, const vf_dataset *ds)

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "vf/json.h"
 #include "vf/workspace.h"
 
 void vf_ingest_defaults(vf_ingest_options *options)
@@ -136,13 +137,15 @@ static json_t *rejections(const score_list *scores, const vf_selection *sel)
     json_t *list = json_array();
     for (int i = 0; i < sel->count; i++) {
         if (sel->verdict[i] == VF_FRAME_BLURRY)
-            json_array_append_new(list, json_pack("{s:i, s:s, s:f, s:f}", "index", i, "reason",
-                                                  "blurry", "sharpness", scores->items[i].sharpness,
-                                                  "local_median", sel->local_median[i]));
+            json_array_append_new(list,
+                                  json_pack("{s:i, s:s, s:o, s:o}", "index", i, "reason", "blurry",
+                                            "sharpness", vf_json_number(scores->items[i].sharpness),
+                                            "local_median", vf_json_number(sel->local_median[i])));
         else if (sel->verdict[i] == VF_FRAME_DUPLICATE)
-            json_array_append_new(list, json_pack("{s:i, s:s, s:i, s:f}", "index", i, "reason",
-                                                  "duplicate", "of", sel->duplicate_of[i],
-                                                  "difference", sel->difference[i]));
+            json_array_append_new(list,
+                                  json_pack("{s:i, s:s, s:i, s:o}", "index", i, "reason",
+                                            "duplicate", "of", sel->duplicate_of[i], "difference",
+                                            vf_json_number(sel->difference[i])));
     }
     return list;
 }
@@ -162,10 +165,10 @@ vf_status vf__ingest_select(const score_list *scores, const vf_select_params *pa
     for (int k = 0; k < selection->chosen_count; k++)
         json_array_append_new(chosen, json_integer(selection->chosen[k]));
     json_object_set_new(report, "selection",
-                        json_pack("{s:i, s:f, s:i, s:f}", "max_frames", params->max_frames,
-                                  "blur_ratio", params->blur_ratio, "blur_window",
+                        json_pack("{s:i, s:o, s:i, s:o}", "max_frames", params->max_frames,
+                                  "blur_ratio", vf_json_number(params->blur_ratio), "blur_window",
                                   params->blur_window, "duplicate_threshold",
-                                  params->duplicate_threshold));
+                                  vf_json_number(params->duplicate_threshold)));
     json_object_set_new(report, "kept", json_integer(selection->chosen_count));
     json_object_set_new(report, "blurry", json_integer(blurry));
     json_object_set_new(report, "duplicates", json_integer(duplicates));
@@ -187,7 +190,7 @@ vf_status vf__ingest_finish(json_t *report, json_t *files, int out_width, int ou
     char path[VF_PATH_MAX];
     json_t *sharpness = json_array();
     for (int i = 0; i < scores->count; i++)
-        json_array_append_new(sharpness, json_real(scores->items[i].sharpness));
+        json_array_append_new(sharpness, vf_json_number(scores->items[i].sharpness));
     json_object_set_new(report, "files", files);
     json_object_set_new(report, "output_width", json_integer(out_width));
     json_object_set_new(report, "output_height", json_integer(out_height));

@@ -7,6 +7,7 @@
 
 #include "ingest_internal.h"
 #include "vf/frames.h"
+#include "vf/json.h"
 #include "vf/log.h"
 
 #define CAPTURE_DIR ".capture"
@@ -85,7 +86,7 @@ static vf_status record(const char *device, const vf_ingest_options *o, const ch
     json_object_set_new(report, "pixel_format", json_string(fourcc));
     json_object_set_new(report, "width", json_integer(info->width));
     json_object_set_new(report, "height", json_integer(info->height));
-    json_object_set_new(report, "nominal_fps", json_real(info->fps));
+    json_object_set_new(report, "nominal_fps", vf_json_number(info->fps));
     status = capture(&in, o, capture_dir, scores, stats);
     vf_frames_close(&in);
     return status;
@@ -133,8 +134,8 @@ vf_status vf_ingest_camera(const char *device, const vf_ingest_options *options,
         status = vf_fail(VF_EINPUT, "camera %s gave no frames in %.3g s", device, stats.seconds);
     if (status == VF_OK) {
         json_object_set_new(report, "frame_count", json_integer(scores.count));
-        json_object_set_new(report, "seconds", json_real(stats.seconds));
-        json_object_set_new(report, "fps", json_real(scores.count / stats.seconds));
+        json_object_set_new(report, "seconds", vf_json_number(stats.seconds));
+        json_object_set_new(report, "fps", vf_json_number(scores.count / stats.seconds));
         json_object_set_new(report, "dropped", json_integer(stats.dropped));
         status = vf__ingest_select(&scores, &options->select, device, report, &sel);
     }

@@ -10,6 +10,7 @@
 
 #include "vf/dataset.h"
 #include "vf/image.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/workspace.h"
 
@@ -106,10 +107,11 @@ static json_t *summarize(const vf_dataset *ds, int has_alpha)
         distance += sqrt(m[3] * m[3] + m[7] * m[7] + m[11] * m[11]) / ds->count;
     }
     const vf_camera *cam = &ds->frames[0].camera;
-    return json_pack("{s:i, s:i, s:i, s:f, s:f, s:b, s:s, s:f}", "frames", ds->count, "width",
-                     cam->width, "height", cam->height, "focal_x", cam->fx, "focal_y", cam->fy,
-                     "distortion", vf_camera_has_distortion(cam), "background",
-                     has_alpha ? "transparent" : "opaque", "mean_camera_distance", distance);
+    return json_pack(
+        "{s:i, s:i, s:i, s:o, s:o, s:b, s:s, s:o}", "frames", ds->count, "width", cam->width,
+        "height", cam->height, "focal_x", vf_json_number(cam->fx), "focal_y",
+        vf_json_number(cam->fy), "distortion", vf_camera_has_distortion(cam), "background",
+        has_alpha ? "transparent" : "opaque", "mean_camera_distance", vf_json_number(distance));
 }
 
 /* Import a posed dataset into the staging folder. */
@@ -170,13 +172,13 @@ static json_t *summarize_capture(const json_t *report)
 static json_t *capture_params(const vf_ingest_request *opt, const char *kind, const json_t *report)
 {
     const vf_ingest_options *cap = &opt->capture;
-    json_t *params =
-        json_pack("{s:s, s:O, s:i, s:i, s:f, s:f}", "source", kind, "input",
-                  json_object_get(json_object_get(report, "source"), "path"), "frames",
-                  cap->select.max_frames, "max_size", cap->max_size, "blur_ratio",
-                  cap->select.blur_ratio, "duplicate_threshold", cap->select.duplicate_threshold);
+    json_t *params = json_pack("{s:s, s:O, s:i, s:i, s:o, s:o}", "source", kind, "input",
+                               json_object_get(json_object_get(report, "source"), "path"), "frames",
+                               cap->select.max_frames, "max_size", cap->max_size, "blur_ratio",
+                               vf_json_number(cap->select.blur_ratio), "duplicate_threshold",
+                               vf_json_number(cap->select.duplicate_threshold));
     if (opt->kind == VF_INGEST_CAMERA) {
-        json_object_set_new(params, "seconds", json_real(cap->seconds));
+        json_object_set_new(params, "seconds", vf_json_number(cap->seconds));
         json_object_set_new(params, "size", json_pack("[i, i]", cap->width, cap->height));
     }
     return params;

@@ -4,6 +4,7 @@
 #include <stdio.h>
 
 #include "ingest_internal.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/video.h"
 
@@ -97,10 +98,11 @@ static vf_status write_chosen(const char *path, const vf_selection *sel, int max
 static void describe_video(json_t *report, const vf_video_info *info, int frames)
 {
     json_object_set_new(report, "codec", json_string(info->codec));
-    json_object_set_new(report, "fps", json_real(info->fps));
+    json_object_set_new(report, "fps", vf_json_number(info->fps));
     json_object_set_new(report, "frame_count", json_integer(frames));
     json_object_set_new(report, "container_frame_count", json_integer(info->frame_count));
-    json_object_set_new(report, "duration_s", json_real(info->fps > 0 ? frames / info->fps : 0));
+    json_object_set_new(report, "duration_s",
+                        vf_json_number(info->fps > 0 ? frames / info->fps : 0));
     json_object_set_new(report, "width", json_integer(info->width));
     json_object_set_new(report, "height", json_integer(info->height));
     json_object_set_new(report, "rotation",

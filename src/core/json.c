@@ -30,11 +30,13 @@ vf_status vf_json_load(const char *path, json_t **out)
     return VF_OK;
 }
 
+json_t *vf_json_number(double x) { return isfinite(x) ? json_real(x) : json_null(); }
+
 json_t *vf_json_doubles(const double *x, int n)
 {
     json_t *a = json_array();
-    for (int i = 0; i < n; i++) /* JSON has no inf or nan: they are written as null */
-        json_array_append_new(a, isfinite(x[i]) ? json_real(x[i]) : json_null());
+    for (int i = 0; i < n; i++)
+        json_array_append_new(a, vf_json_number(x[i]));
     return a;
 }
 

@@ -14,6 +14,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "vf/json.h"
 #include "vf/log.h"
 
 #define MANIFEST "manifest.json"
@@ -499,10 +500,10 @@ vf_status vf_stage_commit(vf_stage *s, json_t *params, json_t *summary)
     json_t *built_on = json_object();
     for (int i = 0; i < s->uses; i++)
         json_object_set_new(built_on, s->used[i], json_string(s->used_id[i]));
-    json_t *record = json_pack("{s:s, s:s, s:s, s:f, s:o, s:o, s:o}", "completed", when, "id", id,
-                               "version", VF_VERSION, "seconds", vf_now() - s->start_time,
-                               "built_on", built_on, "params", params ? params : json_object(),
-                               "summary", summary ? summary : json_object());
+    json_t *record = json_pack(
+        "{s:s, s:s, s:s, s:o, s:o, s:o, s:o}", "completed", when, "id", id, "version", VF_VERSION,
+        "seconds", vf_json_number(vf_now() - s->start_time), "built_on", built_on, "params",
+        params ? params : json_object(), "summary", summary ? summary : json_object());
     vf_status status =
         record ? VF_OK : vf_fail(VF_EINTERNAL, "cannot record %s in the manifest", s->name);
     if (status == VF_OK)

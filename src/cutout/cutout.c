@@ -411,7 +411,7 @@ vf_status vf_cutout_mask(const vf_rgb8 *photo, const vf_camera *cam, const doubl
             status = vf_fail(VF_EINTERNAL, "out of memory");
         if (status == VF_OK) {
             seed_labels(labels, w, h, proj, n, hull_pts, hn, o);
-            status = vf__grabcut(small.data, w, h, labels, o->iterations);
+            status = vf_cv_grabcut(small.data, w, h, labels, o->iterations);
         }
         for (int i = 0; status == VF_OK && i < w * h; i++)
             labels[i] = labels[i] == VF_GC_FGD || labels[i] == VF_GC_PR_FGD;
@@ -582,20 +582,22 @@ vf_status vf_cutout_views(const vf_dataset *views, const char *points_dir, const
         for (int i = 0; i < views->count; i++) {
             char name[VF_PATH_MAX];
             vf_path_basename(name, sizeof name, views->frames[i].image_path, 0);
-            json_array_append_new(list, json_pack("{s:s, s:f, s:i}", "image", name, "coverage",
-                                                  results[i].coverage, "points", results[i].seen));
+            json_array_append_new(list, json_pack("{s:s, s:o, s:i}", "image", name, "coverage",
+                                                  vf_json_number(results[i].coverage), "points",
+                                                  results[i].seen));
             sum += results[i].coverage;
             empty += results[i].coverage == 0;
         }
-        *report = json_pack("{s:i, s:i, s:i, s:b, s:f, s:i, s:o}", "object_points", pts.count,
+        *report = json_pack("{s:i, s:i, s:i, s:b, s:o, s:i, s:o}", "object_points", pts.count,
                             "candidates", pts.candidates, "on_surface", pts.on_plane,
                             "surface_found", pts.has_plane, "mean_coverage",
-                            views->count ? sum / views->count : 0.0, "empty_views", empty,
-                            "views", list);
+                            vf_json_number(views->count ? sum / views->count : 0.0), "empty_views",
+                            empty, "views", list);
         if (pts.has_plane) /* the train stage cuts it out of the field too */
-            json_object_set_new(*report, "surface", json_pack("[f,f,f,f]", pts.plane[0],
-                                                              pts.plane[1], pts.plane[2],
-                                                              pts.plane[3]));
+            json_object_set_new(
+                *report, "surface",
+                json_pack("[o,o,o,o]", vf_json_number(pts.plane[0]), vf_json_number(pts.plane[1]),
+                          vf_json_number(pts.plane[2]), vf_json_number(pts.plane[3])));
         if (empty)
             vf_warn("object mode: %d of %d views show no object; their masks vote against "
                     "everything they see", empty, views->count);

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <new>
 
-extern "C" vf_status vf__grabcut(const uint8_t *rgb, int width, int height, uint8_t *labels,
+extern "C" vf_status vf_cv_grabcut(const uint8_t *rgb, int width, int height, uint8_t *labels,
                                  int iterations)
 {
     try {

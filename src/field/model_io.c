@@ -12,6 +12,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -432,6 +433,50 @@ vf_status vf_field_trainer_save_checkpoint(vf_field_trainer *t, const char *path
     return status;
 }
 
+/* The options a user sets (train's flags), compared between a checkpoint and a resume; the
+ * differences as "--depth 10 (asked 0), ..." into why. Returns how many differ. */
+static int options_differ(const vf_field_train_options *ran, const vf_field_train_options *asked,
+                          char *why, size_t size)
+{
+    static const struct {
+        const char *flag;
+        size_t offset;
+    } weights[] = {
+        {"--view-smoothing", offsetof(vf_field_train_options, tv_view)},
+        {"--depth", offsetof(vf_field_train_options, depth)},
+        {"--appearance (rate)", offsetof(vf_field_train_options, appearance)},
+    };
+    int n = 0;
+    size_t used = 0;
+    why[0] = 0;
+#define WHY(...)                                                                                \
+    do {                                                                                        \
+        if (used < size)                                                                        \
+            used += (size_t)snprintf(why + used, size - used, "%s", n++ ? ", " : "");          \
+        if (used < size)                                                                        \
+            used += (size_t)snprintf(why + used, size - used, __VA_ARGS__);                    \
+    } while (0)
+    if (ran->seconds != asked->seconds || ran->steps != asked->steps)
+        WHY("a budget of %g%s (asked %g%s)", ran->seconds > 0 ? ran->seconds / 60 : ran->steps,
+            ran->seconds > 0 ? " minutes" : " steps",
+            asked->seconds > 0 ? asked->seconds / 60 : asked->steps,
+            asked->seconds > 0 ? " minutes" : " steps");
+    if (ran->surroundings != asked->surroundings)
+        WHY("--surroundings %s (asked %s)", vf_field_surroundings_name(ran->surroundings),
+            vf_field_surroundings_name(asked->surroundings));
+    if (ran->color != asked->color)
+        WHY("--color %s (asked %s)", vf_field_color_name(ran->color),
+            vf_field_color_name(asked->color));
+    for (size_t i = 0; i < sizeof weights / sizeof weights[0]; i++) {
+        float a = *(const float *)((const char *)ran + weights[i].offset);
+        float b = *(const float *)((const char *)asked + weights[i].offset);
+        if (a != b)
+            WHY("%s %g (asked %g)", weights[i].flag, a, b);
+    }
+#undef WHY
+    return n;
+}
+
 vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
 {
     stream s;
@@ -441,6 +486,7 @@ vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
     char magic[8];
     uint32_t version = 0;
     checkpoint_state st;
+    char why[512];
     get(&s, magic, 8);
     get(&s, &version, sizeof version);
     if (s.failed || memcmp(magic, CHECKPOINT_MAGIC, 8) != 0)
@@ -454,19 +500,13 @@ vf_status vf__trainer_checkpoint_read(vf_field_trainer *t, const char *path)
             status = vf_fail(VF_EINPUT, "%s is truncated or from another build", path);
         else if (st.fingerprint != vf__trainer_views_fingerprint(t))
             status = vf_fail(VF_EINPUT, "%s was made from other training images or poses", path);
-        else if (st.options.seconds != t->opt.seconds || st.options.steps != t->opt.steps ||
-                 st.options.surroundings != t->opt.surroundings || st.options.color != t->opt.color)
-            /* the schedule (upsampling, pruning) is laid out over the budget: refuse a new one
-             * rather than silently keep the old, so what ran is what the user asked */
-            status =
-                vf_fail(VF_EINPUT,
-                        "the interrupted training in %s ran with a budget of "
-                        "%g%s, --surroundings %s and --color %s; give the same to continue it, "
-                        "or --restart",
-                        path, st.options.seconds > 0 ? st.options.seconds / 60 : st.options.steps,
-                        st.options.seconds > 0 ? " minutes" : " steps",
-                        vf_field_surroundings_name(st.options.surroundings),
-                        vf_field_color_name(st.options.color));
+        else if (options_differ(&st.options, &t->opt, why, sizeof why))
+            /* what ran must be what the user asked (and the manifest records): the schedule
+             * (upsampling, pruning) is laid out over the budget, the losses over their weights */
+            status = vf_fail(VF_EINPUT,
+                             "the interrupted training in %s ran with %s; give the same to "
+                             "continue it, or --restart",
+                             path, why);
     }
     vf_field *f = NULL;
     if (status == VF_OK)

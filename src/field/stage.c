@@ -9,6 +9,7 @@
 #include "vf/colmap_model.h"
 #include "vf/cutout.h"
 #include "vf/dataset.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/metrics.h"
 #include "vf/object3d.h"
@@ -195,10 +196,11 @@ static vf_status cut_field(vf_field *field, const vf_dataset *cut, int holdout,
     }
     if (status == VF_OK)
         json_object_set_new(cut_report, "field_cut",
-                            json_pack("{s:i, s:f, s:b, s:f, s:f}", "voting_views", n,
-                                      "vote_share", OBJECT_VOTE_SHARE, "surface_removed",
-                                      has_plane, "surface_clearance", OBJECT_SURFACE_CLEARANCE,
-                                      "kept_share", kept));
+                            json_pack("{s:i, s:o, s:b, s:o, s:o}", "voting_views", n, "vote_share",
+                                      vf_json_number(OBJECT_VOTE_SHARE), "surface_removed",
+                                      has_plane, "surface_clearance",
+                                      vf_json_number(OBJECT_SURFACE_CLEARANCE), "kept_share",
+                                      vf_json_number(kept)));
     for (int i = 0; i < cut->count && masks; i++)
         free(masks[i]);
     free(masks);
@@ -243,50 +245,70 @@ static vf_status sheet_tile(const vf_image *img, vf_image *out)
     return vf_image_resize(img, w > 0 ? w : 1, SHEET_HEIGHT, out);
 }
 
-/* PSNR and SSIM of the held-out views; adds a per-view list to report, and writes sheet_path:
- * the first few held-out photos beside their renders. In object mode (object_cut) a photo is
- * cut out by the field's silhouette, and *mean_psnr_object is the PSNR inside it. */
-static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int holdout,
-                                int object_cut, const char *sheet_path, json_t *report,
-                                double *mean_psnr, double *mean_ssim, double *mean_psnr_object)
+#define ERROR_GAIN 4.0f /* error images: |render - photo| x 4, so 0.25 off shows white */
+
+/* DIR/render_NNN.png and DIR/error_NNN.png of one view. */
+static vf_status save_view(const char *dir, int index, const vf_image *render,
+                           const vf_image *photo)
 {
-    double object_sum = 0;
-    int object_n = 0;
+    char path[VF_PATH_MAX];
+    vf_image error = {0};
+    snprintf(path, sizeof path, "%s/render_%03d.png", dir, index);
+    vf_status status = vf_image_save(path, render);
+    if (status == VF_OK)
+        status = vf_image_error_map(render, photo, ERROR_GAIN, &error);
+    snprintf(path, sizeof path, "%s/error_%03d.png", dir, index);
+    if (status == VF_OK)
+        status = vf_image_save(path, &error);
+    vf_image_free(&error);
+    return status;
+}
+
+vf_status vf_field_score_photos(const vf_field *f, const vf_dataset *views,
+                                const vf_photo_scoring *how, json_t *list, vf_photo_scores *out)
+{
+    double object_sum = 0, psnr_sum = 0, ssim_sum = 0;
+    int object_n = 0, n = 0, tiles = 0, chosen = 0;
     float bg[3];
     vf_field_background(f, bg);
-    json_t *list = json_array();
-    double psnr_sum = 0, ssim_sum = 0;
-    int n = 0, tiles = 0;
     vf_image sheet[2 * SHEET_PAIRS] = {{0}};
     char captions[2 * SHEET_PAIRS][96];
     vf_status status = VF_OK;
+    for (int i = 0; i < views->count; i++)
+        chosen += !how->holdout || is_held_out(i, how->holdout);
+    vf_progress progress;
+    vf_progress_begin(&progress, "scoring", (size_t)chosen, "views");
     for (int i = 0; i < views->count && status == VF_OK; i++) {
-        if (!is_held_out(i, holdout))
+        if (how->holdout && !is_held_out(i, how->holdout))
             continue;
+        const vf_frame *frame = &views->frames[i];
         vf_image raw = {0}, photo = {0}, render = {0}; /* raw: a cut-out's alpha is its mask */
-        status = vf_image_load(views->frames[i].image_path, &raw);
-        if (status == VF_OK && object_cut)
-            status = vf_field_cut_photo(f, &views->frames[i].camera, views->frames[i].c2w, &raw);
+        status = vf_image_load(frame->image_path, &raw);
+        if (status == VF_OK && how->object_cut)
+            status = vf_field_cut_photo(f, &frame->camera, frame->c2w, &raw);
         if (status == VF_OK)
             status = vf_image_to_rgb(&raw, bg, &photo);
         if (status == VF_OK)
-            status = vf_field_render(f, &views->frames[i].camera, views->frames[i].c2w, &render);
-        if (status == VF_OK && raw.channels == 4) {
+            status = vf_field_render(f, &frame->camera, frame->c2w, &render);
+        if (status == VF_OK && raw.channels == 4) { /* the PSNR inside the photo's mask */
             double p = vf_image_psnr_masked(&render, &photo, &raw);
             if (p >= 0)
                 object_sum += p, object_n++;
         }
         vf_image_free(&raw);
+        if (status == VF_OK && how->save_dir)
+            status = save_view(how->save_dir, n, &render, &photo);
         if (status == VF_OK) {
             double psnr = vf_image_psnr(&render, &photo), ssim = vf_image_ssim(&render, &photo);
             psnr_sum += psnr;
             ssim_sum += ssim;
             n++;
             char name[VF_PATH_MAX];
-            vf_path_basename(name, sizeof name, views->frames[i].image_path, 0);
-            json_array_append_new(
-                list, json_pack("{s:s, s:f, s:f}", "image", name, "psnr", psnr, "ssim", ssim));
-            if (tiles < 2 * SHEET_PAIRS) {
+            vf_path_basename(name, sizeof name, frame->image_path, 0);
+            json_array_append_new(list,
+                                  json_pack("{s:s, s:o, s:o}", "image", name, "psnr",
+                                            vf_json_number(psnr), "ssim", vf_json_number(ssim)));
+            if (how->sheet_path && tiles < 2 * SHEET_PAIRS) {
                 snprintf(captions[tiles], sizeof captions[tiles], "photo %.80s", name);
                 status = sheet_tile(&photo, &sheet[tiles++]);
                 snprintf(captions[tiles], sizeof captions[tiles], "render\n%.1f dB", psnr);
@@ -296,19 +318,22 @@ static vf_status score_held_out(const vf_field *f, const vf_dataset *views, int 
         }
         vf_image_free(&photo);
         vf_image_free(&render);
+        vf_progress_update(&progress, (size_t)n, NULL);
     }
+    if (status == VF_OK)
+        vf_progress_end(&progress);
     if (status == VF_OK && tiles > 0) {
         const char *caption_list[2 * SHEET_PAIRS];
         for (int i = 0; i < tiles; i++)
             caption_list[i] = captions[i];
-        status = vf_contact_sheet(sheet_path, sheet, caption_list, NULL, tiles, 4);
+        status = vf_contact_sheet(how->sheet_path, sheet, caption_list, NULL, tiles, 4);
     }
     for (int i = 0; i < tiles; i++)
         vf_image_free(&sheet[i]);
-    *mean_psnr = n ? psnr_sum / n : NAN;
-    *mean_ssim = n ? ssim_sum / n : NAN;
-    *mean_psnr_object = object_n ? object_sum / object_n : NAN;
-    json_object_set_new(report, "held_out", list);
+    *out = (vf_photo_scores){.count = n,
+                             .psnr = n ? psnr_sum / n : NAN,
+                             .ssim = n ? ssim_sum / n : NAN,
+                             .psnr_object = object_n ? object_sum / object_n : NAN};
     return status;
 }
 
@@ -415,9 +440,16 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
     char sheet[VF_PATH_MAX];
     if (status == VF_OK)
         status = vf_path_join(sheet, sizeof sheet, stage.dir, "held_out.jpg");
-    if (status == VF_OK)
-        status = score_held_out(field, &views, opt->holdout, opt->object_only, sheet, report,
-                                &psnr, &ssim, &psnr_object);
+    vf_photo_scores scores = {0, NAN, NAN, NAN};
+    json_t *held_out = json_array();
+    if (status == VF_OK && held > 0)
+        status = vf_field_score_photos(field, &views,
+                                       &(vf_photo_scoring){.holdout = opt->holdout,
+                                                           .object_cut = opt->object_only,
+                                                           .sheet_path = sheet},
+                                       held_out, &scores);
+    json_object_set_new(report, "held_out", held_out);
+    psnr = scores.psnr, ssim = scores.ssim, psnr_object = scores.psnr_object;
     if (status == VF_OK)
         status = vf_path_join(model, sizeof model, stage.dir, VF_FIELD_FILE);
     if (status == VF_OK)
@@ -431,20 +463,23 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                            : with_alpha               ? "object box (background-removed photos)"
                                                       : "object box only";
         json_object_update_new(report,
-                               json_pack("{s:i, s:i, s:i, s:f, s:s, s:s, s:f, s:s, s:[i,i,i], s:I}",
+                               json_pack("{s:i, s:i, s:i, s:o, s:s, s:s, s:o, s:s, s:[i,i,i], s:I}",
                                          "views", views.count - held, "held_out_views", held,
-                                         "steps", st.step, "seconds", st.elapsed, "surroundings",
-                                         info.has_background_grid ? "grid" : "none", "color",
-                                         vf_field_color_name(opt->color), "view_smoothing",
-                                         (double)topt.tv_view, "field", kind, "grid", info.dim[0],
-                                         info.dim[1], info.dim[2], "bytes", (json_int_t)info.bytes));
+                                         "steps", st.step, "seconds", vf_json_number(st.elapsed),
+                                         "surroundings", info.has_background_grid ? "grid" : "none",
+                                         "color", vf_field_color_name(opt->color), "view_smoothing",
+                                         vf_json_number((double)topt.tv_view), "field", kind,
+                                         "grid", info.dim[0], info.dim[1], info.dim[2], "bytes",
+                                         (json_int_t)info.bytes));
         /* the trainer's automatic choices for this capture (vf/field.h) */
         const vf_field_train_options *used = vf_field_trainer_options(t);
-        json_object_set_new(report, "color_smoothing", json_real(used->tv_color));
+        json_object_set_new(report, "color_smoothing", vf_json_number(used->tv_color));
         json_object_set_new(report, "levels", json_integer(used->levels));
         /* the distortion loss acts on opaque photos only */
-        json_object_set_new(report, "distortion", json_real(with_alpha ? 0.0 : used->distortion));
-        json_object_set_new(report, "appearance", json_real(with_alpha ? 0.0 : used->appearance));
+        json_object_set_new(report, "distortion",
+                            vf_json_number(with_alpha ? 0.0 : used->distortion));
+        json_object_set_new(report, "appearance",
+                            vf_json_number(with_alpha ? 0.0 : used->appearance));
         /* the training photos' sightings of sparse points given to the depth loss (0: off) */
         const long supervising = used->depth > 0 && !with_alpha ? point_total : 0;
         json_object_set_new(report, "depth_points", json_integer(supervising));
@@ -453,10 +488,11 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         vf_info("field: %s, %s colour", kind,
                 opt->color == VF_COLOR_DIFFUSE ? "diffuse" : "view-dependent");
         if (held)
-            json_object_update_new(
-                report, json_pack("{s:f, s:f}", "held_out_psnr", psnr, "held_out_ssim", ssim));
+            json_object_update_new(report,
+                                   json_pack("{s:o, s:o}", "held_out_psnr", vf_json_number(psnr),
+                                             "held_out_ssim", vf_json_number(ssim)));
         if (held && isfinite(psnr_object))
-            json_object_set_new(report, "held_out_psnr_object", json_real(psnr_object));
+            json_object_set_new(report, "held_out_psnr_object", vf_json_number(psnr_object));
         status = vf_path_join(report_path, sizeof report_path, stage.dir, "report.json");
     }
     if (status == VF_OK)
@@ -470,19 +506,18 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
         /* keep the staging folder (and its checkpoint) so the next run can resume */
         return status;
     }
-    json_t *summary = held ? json_pack("{s:f, s:f, s:i}", "held_out_psnr", psnr, "held_out_ssim",
-                                       ssim, "steps", st.step)
+    json_t *summary = held ? json_pack("{s:o, s:o, s:i}", "held_out_psnr", vf_json_number(psnr),
+                                       "held_out_ssim", vf_json_number(ssim), "steps", st.step)
                            : json_pack("{s:i}", "steps", st.step);
-    status = vf_stage_commit(&stage,
-                             json_pack("{s:f, s:i, s:i, s:s, s:s, s:f, s:f, s:b, s:b}", "minutes",
-                                       minutes, "steps", opt->steps, "holdout", opt->holdout,
-                                       "surroundings",
-                                       vf_field_surroundings_name(opt->surroundings), "color",
-                                       vf_field_color_name(opt->color), "view_smoothing",
-                                       (double)topt.tv_view, "depth", (double)topt.depth,
-                                       "appearance", opt->appearance, "object_only",
-                                       opt->object_only),
-                             json_incref(summary));
+    status = vf_stage_commit(
+        &stage,
+        json_pack("{s:o, s:i, s:i, s:s, s:s, s:o, s:o, s:b, s:b}", "minutes",
+                  vf_json_number(minutes), "steps", opt->steps, "holdout", opt->holdout,
+                  "surroundings", vf_field_surroundings_name(opt->surroundings), "color",
+                  vf_field_color_name(opt->color), "view_smoothing",
+                  vf_json_number((double)topt.tv_view), "depth", vf_json_number((double)topt.depth),
+                  "appearance", opt->appearance, "object_only", opt->object_only),
+        json_incref(summary));
     /* The checkpoint goes only once the stage is in place: after a failed commit the next run
      * resumes from it at its end instead of training again. */
     if (status == VF_OK &&

@@ -36,7 +36,7 @@ void vf_image_free(vf_image *img)
 vf_status vf_image_info(const char *path, int *width, int *height, int *channels)
 {
     int w, h, orientation;
-    vf_status status = vf__oiio_info(path, &w, &h, channels, &orientation);
+    vf_status status = vf_oiio_info(path, &w, &h, channels, &orientation);
     if (status == VF_OK) {
         *width = orientation >= 5 ? h : w;
         *height = orientation >= 5 ? w : h;
@@ -49,7 +49,7 @@ vf_status vf_image_load(const char *path, vf_image *out)
     vf_image img;
     int orientation;
     vf_status status =
-        vf__oiio_read(path, &img.data, &img.width, &img.height, &img.channels, &orientation);
+        vf_oiio_read(path, &img.data, &img.width, &img.height, &img.channels, &orientation);
     if (status != VF_OK || orientation == 1) {
         if (status == VF_OK)
             *out = img;
@@ -67,7 +67,7 @@ vf_status vf_image_save(const char *path, const vf_image *img)
     unsigned char *bytes = NULL;
     size_t size = 0;
     vf_status status =
-        vf__oiio_encode(path, img->data, img->width, img->height, img->channels, &bytes, &size);
+        vf_oiio_encode(path, img->data, img->width, img->height, img->channels, &bytes, &size);
     if (status == VF_OK)
         status = vf_write_file_atomic(path, bytes, size);
     free(bytes);
@@ -115,7 +115,7 @@ vf_status vf_image_load_rgb(const char *path, const float background[3], vf_imag
 vf_status vf_image_orientation(const char *path, int *orientation)
 {
     int w, h, channels;
-    return vf__oiio_info(path, &w, &h, &channels, orientation);
+    return vf_oiio_info(path, &w, &h, &channels, orientation);
 }
 
 void vf_orientation_source(int orientation, int w, int h, int u, int v, int *x, int *y)

@@ -149,7 +149,7 @@ int orientation_of(ImageInput &in)
 
 } // namespace
 
-extern "C" vf_status vf__oiio_info(const char *path, int *width, int *height, int *channels,
+extern "C" vf_status vf_oiio_info(const char *path, int *width, int *height, int *channels,
                                    int *orientation)
 {
     std::unique_ptr<ImageInput> in;
@@ -163,7 +163,7 @@ extern "C" vf_status vf__oiio_info(const char *path, int *width, int *height, in
     return VF_OK;
 }
 
-extern "C" vf_status vf__oiio_read(const char *path, float **pixels, int *width, int *height,
+extern "C" vf_status vf_oiio_read(const char *path, float **pixels, int *width, int *height,
                                    int *channels, int *orientation)
 {
     std::unique_ptr<ImageInput> in;
@@ -191,7 +191,7 @@ extern "C" vf_status vf__oiio_read(const char *path, float **pixels, int *width,
     return VF_OK;
 }
 
-extern "C" vf_status vf__oiio_encode(const char *path, const float *pixels, int width,
+extern "C" vf_status vf_oiio_encode(const char *path, const float *pixels, int width,
                                      int height, int channels, unsigned char **bytes,
                                      size_t *size)
 {

@@ -142,7 +142,7 @@ extern "C" vf_status vf_rgb8_encode_jpeg(const vf_rgb8 *img, int quality, unsign
     return VF_OK;
 }
 
-extern "C" vf_status vf__cv_read(const char *path, vf_rgb8 *out)
+extern "C" vf_status vf_cv_read(const char *path, vf_rgb8 *out)
 {
     QuietLog quiet;
     try {

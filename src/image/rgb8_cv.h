@@ -12,7 +12,7 @@ extern "C" {
 #endif
 
 /* Decode the file at path as stored, into out (reused). VF_EINPUT "cannot read PATH: ...". */
-vf_status vf__cv_read(const char *path, vf_rgb8 *out);
+vf_status vf_cv_read(const char *path, vf_rgb8 *out);
 
 #ifdef __cplusplus
 }

@@ -14,9 +14,9 @@ vf_status vf_rgb8_load(const char *path, vf_rgb8 *out)
         return vf_fail(VF_EINPUT, "cannot read %s: no such file", path);
     int orientation;
     if (vf_image_orientation(path, &orientation) != VF_OK || orientation < 2 || orientation > 8)
-        return vf__cv_read(path, out); /* upright as stored (OpenCV judges what it can read) */
+        return vf_cv_read(path, out); /* upright as stored (OpenCV judges what it can read) */
     vf_rgb8 stored = {0};
-    vf_status status = vf__cv_read(path, &stored);
+    vf_status status = vf_cv_read(path, &stored);
     int w = stored.width, h = stored.height, swap = orientation >= 5;
     if (status == VF_OK)
         status = vf_rgb8_resize_buffer(out, swap ? h : w, swap ? w : h);

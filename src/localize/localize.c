@@ -13,6 +13,7 @@
 #include "localize_internal.h"
 #include "vf/colmap_model.h"
 #include "vf/fsutil.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/targets.h"
 #include "vf/workspace.h"
@@ -35,21 +36,18 @@ void vf_localize_defaults(vf_localize_options *opt)
 
 /* ---- the map ---- */
 
-static vf_status load_map(vf_localizer *loc, const char *ws_root)
+static vf_status load_map(vf_localizer *loc, const vf_workspace *ws)
 {
     char poses[VF_PATH_MAX], path[VF_PATH_MAX];
-    vf_status status = vf_path_join(poses, sizeof poses, ws_root, "poses");
-    if (status == VF_OK && !vf_is_dir(poses))
-        return vf_fail(VF_EINPUT, "workspace %s has no poses: run 'vfcapture poses %s' first",
-                       ws_root, ws_root);
+    vf_status status = vf_workspace_need(ws, "poses"); /* a folder alone may be half-written */
+    if (status == VF_OK)
+        status = vf_workspace_path(ws, "poses", "", poses, sizeof poses);
     if (status == VF_OK)
         status = vf_path_join(path, sizeof path, poses, "sparse");
     if (status == VF_OK)
         status = vf_colmap_model_load(path, &loc->model);
     if (status == VF_OK)
-        status = vf_path_join(path, sizeof path, poses, VF_NORMALIZATION_FILE);
-    if (status == VF_OK)
-        status = vf_normalization_load(path, &loc->object_from_colmap, NULL);
+        status = vf_normalization_load_workspace(ws, &loc->object_from_colmap, NULL, NULL);
     if (status == VF_OK)
         status = vf_path_join(path, sizeof path, poses, "database.db");
     if (status == VF_OK)
@@ -67,7 +65,7 @@ static vf_status load_map(vf_localizer *loc, const char *ws_root)
     return VF_OK;
 }
 
-vf_status vf_localizer_open(const char *ws_root, const vf_localize_options *opt,
+vf_status vf_localizer_open(const vf_workspace *ws, const vf_localize_options *opt,
                             vf_localizer **out)
 {
     *out = NULL;
@@ -78,7 +76,7 @@ vf_status vf_localizer_open(const char *ws_root, const vf_localize_options *opt,
         loc->opt = *opt;
     else
         vf_localize_defaults(&loc->opt);
-    vf_status status = load_map(loc, ws_root);
+    vf_status status = load_map(loc, ws);
     if (status != VF_OK) {
         vf_localizer_close(loc);
         return status;
@@ -344,9 +342,10 @@ vf_status vf_localize_frame(vf_localizer *loc, const vf_rgb8 *frame, vf_localize
 json_t *vf_localize_result_json(const vf_localize_result *r)
 {
     json_t *o =
-        json_pack("{s:b, s:i, s:i, s:i, s:f, s:f, s:f}", "localized", r->localized, "features",
+        json_pack("{s:b, s:i, s:i, s:i, s:o, s:o, s:o}", "localized", r->localized, "features",
                   r->features, "matches", r->matches, "inliers", r->inliers, "inlier_ratio",
-                  r->inlier_ratio, "reprojection_px", r->reprojection_px, "seconds", r->seconds);
+                  vf_json_number(r->inlier_ratio), "reprojection_px",
+                  vf_json_number(r->reprojection_px), "seconds", vf_json_number(r->seconds));
     if (!r->localized) {
         json_object_set_new(o, "reason", json_string(r->reason));
         return o;

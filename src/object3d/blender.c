@@ -63,23 +63,25 @@ static json_t *job_json(const vf__blender_job *job, const char *info_path)
         vf__blender_view_file(job->prefix, i, file, sizeof file);
         json_t *m = json_array();
         for (int k = 0; k < 16; k++)
-            json_array_append_new(m, json_real(job->c2w[16 * i + k]));
+            json_array_append_new(m, vf_json_number(job->c2w[16 * i + k]));
         json_array_append_new(views, json_pack("{s:s, s:o}", "file", file, "c2w", m));
     }
     json_t *normalize = json_null();
     if (job->transform) {
         const vf_object3d_transform *t = job->transform;
-        normalize = json_pack("{s:[f,f,f], s:f}", "center", t->center[0], t->center[1],
-                              t->center[2], "scale", t->scale);
+        normalize = json_pack("{s:[o,o,o], s:o}", "center", vf_json_number(t->center[0]),
+                              vf_json_number(t->center[1]), vf_json_number(t->center[2]), "scale",
+                              vf_json_number(t->scale));
     }
     const vf_camera *c = &job->camera;
-    return json_pack("{s:s, s:o, s:i, s:i, s:f, s:f, s:f, s:f, s:i, s:s, s:f, s:o, s:s, s:s, "
+    return json_pack("{s:s, s:o, s:i, s:i, s:o, s:o, s:o, s:o, s:i, s:s, s:o, s:o, s:s, s:s, "
                      "s:b}",
                      "model", job->model, "normalize", normalize, "width", c->width, "height",
-                     c->height, "fx", c->fx, "fy", c->fy, "cx", c->cx, "cy", c->cy, "samples",
-                     job->samples, "scene", job->scene ? job->scene : "studio", "shutter",
-                     job->shutter, "views", views, "output_dir", job->out_dir, "info", info_path,
-                     "serve", job->serve);
+                     c->height, "fx", vf_json_number(c->fx), "fy", vf_json_number(c->fy), "cx",
+                     vf_json_number(c->cx), "cy", vf_json_number(c->cy), "samples", job->samples,
+                     "scene", job->scene ? job->scene : "studio", "shutter",
+                     vf_json_number(job->shutter), "views", views, "output_dir", job->out_dir,
+                     "info", info_path, "serve", job->serve);
 }
 
 /* What one run follows in Blender's output. */

@@ -10,6 +10,7 @@
 
 #include "object3d_internal.h"
 #include "vf/dataset.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/pose.h"
 #include "vf/rng.h"
@@ -115,11 +116,12 @@ static vf_status prepare_folder(const char *model, const vf_object3d_capture *c,
     if (stat(model, &st) != 0)
         return vf_fail(VF_EINPUT, "cannot read %s: no such file", model);
     json_t *request =
-        json_pack("{s:s, s:I, s:I, s:i, s:i, s:i, s:i, s:f, s:f, s:f, s:I, s:s}", "model", model,
+        json_pack("{s:s, s:I, s:I, s:i, s:i, s:i, s:i, s:o, s:o, s:o, s:I, s:s}", "model", model,
                   "bytes", (json_int_t)st.st_size, "mtime", (json_int_t)st.st_mtime, "views",
                   c->views, "test_views", c->test_views, "size", c->size, "samples", c->samples,
-                  "distance", c->distance, "camera_angle_x", c->camera_angle_x, "min_elevation",
-                  c->min_elevation, "seed", (json_int_t)c->seed, "scene", c->scene);
+                  "distance", vf_json_number(c->distance), "camera_angle_x",
+                  vf_json_number(c->camera_angle_x), "min_elevation",
+                  vf_json_number(c->min_elevation), "seed", (json_int_t)c->seed, "scene", c->scene);
     static const char *const renders[] = {"images", "test", NULL};
     return vf__keep_renders_for(out_dir, request, renders);
 }
@@ -129,16 +131,17 @@ static json_t *object_json(const char *model, const json_t *fit, const vf_object
 {
     struct stat st;
     json_int_t bytes = stat(model, &st) == 0 ? (json_int_t)st.st_size : -1;
-    return json_pack(
-        "{s:i, s:s, s:I, s:{s:O, s:O}, s:O, s:O, s:O, s:{s:i, s:i, s:i, s:i, s:f, "
-        "s:f, s:f, s:s}, s:o}",
-        "format", OBJECT_FORMAT, "model", model, "bytes", bytes, "transform", "center",
-        json_object_get(fit, "center"), "scale", json_object_get(fit, "scale"), "vertices",
-        json_object_get(fit, "vertices"), "meshes", json_object_get(fit, "meshes"), "radius",
-        json_object_get(fit, "radius"), "render", "views", c->views, "test_views", c->test_views,
-        "size", c->size, "samples", c->samples, "distance", c->distance, "camera_angle_x",
-        c->camera_angle_x, "min_elevation", c->min_elevation, "scene", c->scene, "mean_coverage",
-        coverage >= 0 ? json_real(coverage) : json_null());
+    return json_pack("{s:i, s:s, s:I, s:{s:O, s:O}, s:O, s:O, s:O, s:{s:i, s:i, s:i, s:i, s:o, "
+                     "s:o, s:o, s:s}, s:o}",
+                     "format", OBJECT_FORMAT, "model", model, "bytes", bytes, "transform", "center",
+                     json_object_get(fit, "center"), "scale", json_object_get(fit, "scale"),
+                     "vertices", json_object_get(fit, "vertices"), "meshes",
+                     json_object_get(fit, "meshes"), "radius", json_object_get(fit, "radius"),
+                     "render", "views", c->views, "test_views", c->test_views, "size", c->size,
+                     "samples", c->samples, "distance", vf_json_number(c->distance),
+                     "camera_angle_x", vf_json_number(c->camera_angle_x), "min_elevation",
+                     vf_json_number(c->min_elevation), "scene", c->scene, "mean_coverage",
+                     coverage >= 0 ? vf_json_number(coverage) : json_null());
 }
 
 static vf_status transform_from_json(const json_t *doc, const char *path,
@@ -222,13 +225,13 @@ vf_status vf_object3d_ingest(const char *model_path, const vf_object3d_capture *
     if (status == VF_OK)
         status = vf_json_save(path, object);
     if (status == VF_OK && report)
-        *report = json_pack("{s:s, s:s, s:i, s:i, s:i, s:i, s:s, s:s, s:f, s:f, s:O, s:O}",
-                            "source", "model", "input", model, "frames", c->views, "test_frames",
-                            c->test_views, "width", c->size, "height", c->size, "scene", c->scene,
-                            "background", studio ? "transparent" : "room", "mean_camera_distance",
-                            c->distance, "seconds", vf_now() - start, "transform",
-                            json_object_get(object, "transform"), "mean_coverage",
-                            json_object_get(object, "mean_coverage"));
+        *report = json_pack(
+            "{s:s, s:s, s:i, s:i, s:i, s:i, s:s, s:s, s:o, s:o, s:O, s:O}", "source", "model",
+            "input", model, "frames", c->views, "test_frames", c->test_views, "width", c->size,
+            "height", c->size, "scene", c->scene, "background", studio ? "transparent" : "room",
+            "mean_camera_distance", vf_json_number(c->distance), "seconds",
+            vf_json_number(vf_now() - start), "transform", json_object_get(object, "transform"),
+            "mean_coverage", json_object_get(object, "mean_coverage"));
     json_decref(object);
     json_decref(fit);
     free(c2w);

@@ -12,6 +12,7 @@
 #include "vf/attack_file.h"
 #include "vf/dataset.h"
 #include "vf/field.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/metrics.h"
 #include "vf/plot.h"
@@ -144,12 +145,12 @@ static vf_status prepare_renders(real_run *r, char *dir, size_t size)
 {
     json_t *poses = json_array();
     for (int i = 0; i < 16 * r->n; i++)
-        json_array_append_new(poses, json_real(r->object_c2w[i]));
-    json_t *request = json_pack("{s:s, s:s, s:i, s:i, s:f, s:f, s:f, s:f, s:i, s:o}", "model",
+        json_array_append_new(poses, vf_json_number(r->object_c2w[i]));
+    json_t *request = json_pack("{s:s, s:s, s:i, s:i, s:o, s:o, s:o, s:o, s:i, s:o}", "model",
                                 r->obj.model, "scene", r->obj.scene, "width", r->cam.width,
-                                "height", r->cam.height, "fx", r->cam.fx, "fy", r->cam.fy, "cx",
-                                r->cam.cx, "cy", r->cam.cy, "samples", r->obj.samples, "c2w",
-                                poses);
+                                "height", r->cam.height, "fx", vf_json_number(r->cam.fx), "fy",
+                                vf_json_number(r->cam.fy), "cx", vf_json_number(r->cam.cx), "cy",
+                                vf_json_number(r->cam.cy), "samples", r->obj.samples, "c2w", poses);
     static const char *const renders[] = {"renders", NULL};
     vf_status s = vf_path_join(dir, size, r->stage.dir, "renders");
     return s == VF_OK ? vf__keep_renders_for(r->stage.dir, request, renders) : s;
@@ -220,7 +221,7 @@ static double mean_psnr(const real_run *r, int first, int count)
 
 static json_t *pair_json(double field, double real)
 {
-    return json_pack("{s:f, s:f}", "field", field, "real", real);
+    return json_pack("{s:o, s:o}", "field", vf_json_number(field), "real", vf_json_number(real));
 }
 
 static json_t *result_json(const real_run *r)
@@ -229,47 +230,50 @@ static json_t *result_json(const real_run *r)
     json_t *levels = json_array(), *field_curve = json_array(), *real_curve = json_array();
     for (int level = 0; level < VF_FLUCT_LEVELS; level++) {
         int first = r->first[G_FLUCT] + level * fl;
-        json_array_append_new(levels, json_real(level + 1));
-        json_array_append_new(field_curve, json_real(fooled_rate(r->field_pred, first, fl)));
-        json_array_append_new(real_curve, json_real(fooled_rate(r->real_pred, first, fl)));
+        json_array_append_new(levels, vf_json_number(level + 1));
+        json_array_append_new(field_curve, vf_json_number(fooled_rate(r->field_pred, first, fl)));
+        json_array_append_new(real_curve, vf_json_number(fooled_rate(r->real_pred, first, fl)));
     }
     json_t *views = json_array();
     for (int g = 0; g < G_COUNT; g++)
         for (int i = r->first[g]; i < r->first[g + 1]; i++) {
             json_t *v = json_array();
             for (int k = 0; k < 6; k++)
-                json_array_append_new(v, json_real(r->views[6 * i + k]));
+                json_array_append_new(v, vf_json_number(r->views[6 * i + k]));
             json_array_append_new(
-                views, json_pack("{s:s, s:i, s:o, s:f, s:o, s:o}", "group", group_names[g],
-                                 "index", i - r->first[g], "view", v, "psnr", r->psnr[i], "field",
-                                 vf_view_prediction_to_json(&r->field_pred[i]), "real",
+                views, json_pack("{s:s, s:i, s:o, s:o, s:o, s:o}", "group", group_names[g], "index",
+                                 i - r->first[g], "view", v, "psnr", vf_json_number(r->psnr[i]),
+                                 "field", vf_view_prediction_to_json(&r->field_pred[i]), "real",
                                  vf_view_prediction_to_json(&r->real_pred[i])));
         }
     int ns = r->af.sample_count, nn = r->first[G_COUNT] - r->first[G_NATURAL];
     return json_pack(
-        "{s:s, s:s, s:s, s:{s:[f,f,f], s:f}, s:s, s:o, s:o, s:o, s:i, s:o, s:{s:o, s:o, s:o, s:i}, "
-        "s:i, s:f, s:f, s:{s:f, s:f, s:f, s:f}, s:{s:f, s:f}, s:o}",
+        "{s:s, s:s, s:s, s:{s:[o,o,o], s:o}, s:s, s:o, s:o, s:o, s:i, s:o, s:{s:o, s:o, s:o, s:i}, "
+        "s:i, s:o, s:o, s:{s:o, s:o, s:o, s:o}, s:{s:o, s:o}, s:o}",
         "object", r->obj.model, "classifier", r->classifier_path, "engine",
         vf_classifier_engine(r->cls), "transform", "center",
-        r->obj.transform.center[0], r->obj.transform.center[1], r->obj.transform.center[2],
-        "scale", r->obj.transform.scale, "label", r->af.label_text, "asr_v_star",
-        pair_json(fooled_rate(r->field_pred, 0, 1), fooled_rate(r->real_pred, 0, 1)),
-        "asr_samples",
+        vf_json_number(r->obj.transform.center[0]), vf_json_number(r->obj.transform.center[1]),
+        vf_json_number(r->obj.transform.center[2]), "scale", vf_json_number(r->obj.transform.scale),
+        "label", r->af.label_text, "asr_v_star",
+        pair_json(fooled_rate(r->field_pred, 0, 1), fooled_rate(r->real_pred, 0, 1)), "asr_samples",
         pair_json(fooled_rate(r->field_pred, r->first[G_SAMPLES], ns),
                   fooled_rate(r->real_pred, r->first[G_SAMPLES], ns)),
         "natural_accuracy",
         pair_json(1 - fooled_rate(r->field_pred, r->first[G_NATURAL], nn),
                   1 - fooled_rate(r->real_pred, r->first[G_NATURAL], nn)),
         "natural_views", nn, "attack",
-        json_pack("{s:f, s:f, s:f}", "asr_v_star", r->af.asr_v_star, "asr_samples",
-                  r->af.asr_samples, "natural_accuracy", r->af.natural_accuracy),
+        json_pack("{s:o, s:o, s:o}", "asr_v_star", vf_json_number(r->af.asr_v_star),
+                  "asr_samples", vf_json_number(r->af.asr_samples), "natural_accuracy",
+                  vf_json_number(r->af.natural_accuracy)),
         "fluctuation", "r_percent", levels, "field", field_curve, "real", real_curve,
-        "samples_per_level", fl, "samples", ns, "agreement", agreement(r, 0, r->n),
-        "agreement_natural", agreement(r, r->first[G_NATURAL], nn), "psnr", "v_star",
-        r->psnr[0], "samples", mean_psnr(r, r->first[G_SAMPLES], ns), "fluctuation",
-        mean_psnr(r, r->first[G_FLUCT], r->first[G_NATURAL] - r->first[G_FLUCT]), "natural",
-        mean_psnr(r, r->first[G_NATURAL], nn), "seconds", "render_object",
-        r->seconds_render, "field_and_classifier", r->seconds_classify, "views", views);
+        "samples_per_level", fl, "samples", ns, "agreement", vf_json_number(agreement(r, 0, r->n)),
+        "agreement_natural", vf_json_number(agreement(r, r->first[G_NATURAL], nn)), "psnr",
+        "v_star", vf_json_number(r->psnr[0]), "samples",
+        vf_json_number(mean_psnr(r, r->first[G_SAMPLES], ns)), "fluctuation",
+        vf_json_number(mean_psnr(r, r->first[G_FLUCT], r->first[G_NATURAL] - r->first[G_FLUCT])),
+        "natural", vf_json_number(mean_psnr(r, r->first[G_NATURAL], nn)), "seconds",
+        "render_object", vf_json_number(r->seconds_render), "field_and_classifier",
+        vf_json_number(r->seconds_classify), "views", views);
 }
 
 /* field | model, for v* and the first samples, captions red when fooled. */

@@ -10,8 +10,11 @@
 #include "shot_card.h"
 #include "vf/attack_file.h"
 #include "vf/calib.h"
+#include "vf/csv.h"
 #include "vf/classifier.h"
+#include "vf/csv.h"
 #include "vf/field.h"
+#include "vf/json.h"
 #include "vf/localize.h"
 #include "vf/log.h"
 #include "vf/resources.h"
@@ -44,14 +47,11 @@ typedef struct export_run {
 
 static vf_status load_inputs(export_run *run, const vf_workspace *ws, const char *attack)
 {
-    char path[VF_PATH_MAX];
     vf_status status = vf_attack_file_load_workspace(ws, attack, &run->attack);
     if (status == VF_OK)
-        status = vf_workspace_path(ws, "poses", VF_NORMALIZATION_FILE, path, sizeof path);
-    if (status == VF_OK && vf_is_file(path)) {
-        status = vf_normalization_load(path, NULL, &run->colmap_from_object);
-        run->has_colmap = status == VF_OK;
-    } else if (status == VF_OK) {
+        status = vf_normalization_load_workspace(ws, NULL, &run->colmap_from_object,
+                                                 &run->has_colmap);
+    if (status == VF_OK && !run->has_colmap) {
         vf_warn("no WS/poses/normalization.json (a posed import): targets in the object frame "
                 "only, no COLMAP frame");
     }
@@ -157,6 +157,10 @@ static vf_status render_previews(export_run *run, const char *dir)
     char folder[VF_PATH_MAX], path[VF_PATH_MAX], name[32];
     vf_camera cam = run->attack.has_camera ? run->attack.camera
                                            : vf_field_classifier_camera(run->field, PREVIEW_SIZE);
+    int side = cam.width > cam.height ? cam.width : cam.height;
+    if (side > 4 * PREVIEW_SIZE) /* a preview, not a poster (the file allows 100000 px) */
+        cam = vf_camera_scaled(&cam, (int)((double)cam.width * 4 * PREVIEW_SIZE / side + 0.5),
+                               (int)((double)cam.height * 4 * PREVIEW_SIZE / side + 0.5));
     vf_status status = vf_path_join(folder, sizeof folder, dir, "previews");
     if (status == VF_OK)
         status = vf_mkdirs(folder);
@@ -183,15 +187,16 @@ static json_t *target_json(const export_run *run, int i)
 {
     const target *t = &run->targets[i];
     const vf_target_words *w = &t->words;
-    json_t *words =
-        json_pack("{s:f, s:f, s:f, s:f, s:f, s:[f,f,f], s:f}", "azimuth_deg", w->azimuth_deg,
-                  "elevation_deg", w->elevation_deg, "distance", w->distance, "height", w->height,
-                  "roll_deg", w->roll_deg, "look_at", w->look_at[0], w->look_at[1], w->look_at[2],
-                  "aim_offset", w->aim_offset);
+    json_t *words = json_pack(
+        "{s:o, s:o, s:o, s:o, s:o, s:[o,o,o], s:o}", "azimuth_deg", vf_json_number(w->azimuth_deg),
+        "elevation_deg", vf_json_number(w->elevation_deg), "distance", vf_json_number(w->distance),
+        "height", vf_json_number(w->height), "roll_deg", vf_json_number(w->roll_deg), "look_at",
+        vf_json_number(w->look_at[0]), vf_json_number(w->look_at[1]), vf_json_number(w->look_at[2]),
+        "aim_offset", vf_json_number(w->aim_offset));
     if (run->metres > 0) {
-        json_object_set_new(words, "distance_m", json_real(to_metres(run, w->distance)));
-        json_object_set_new(words, "height_m", json_real(to_metres(run, w->height)));
-        json_object_set_new(words, "aim_offset_m", json_real(to_metres(run, w->aim_offset)));
+        json_object_set_new(words, "distance_m", vf_json_number(to_metres(run, w->distance)));
+        json_object_set_new(words, "height_m", vf_json_number(to_metres(run, w->height)));
+        json_object_set_new(words, "aim_offset_m", vf_json_number(to_metres(run, w->aim_offset)));
     }
     json_t *o =
         json_pack("{s:i, s:s, s:o, s:o, s:o}", "index", i, "kind", t->kind, "viewpoint",
@@ -200,16 +205,18 @@ static json_t *target_json(const export_run *run, int i)
         double look_colmap[3];
         vf_similarity_apply(&run->colmap_from_object, w->look_at, look_colmap);
         json_object_set_new(words, "look_at_colmap",
-                            json_pack("[f,f,f]", look_colmap[0], look_colmap[1], look_colmap[2]));
+                            json_pack("[o,o,o]", vf_json_number(look_colmap[0]),
+                                      vf_json_number(look_colmap[1]),
+                                      vf_json_number(look_colmap[2])));
         json_object_set_new(o, "c2w_colmap", vf_json_mat4(t->c2w_colmap));
     }
     if (t->sample >= 0)
         json_object_set_new(o, "sample", json_integer(t->sample));
     if (t->pred.cls >= 0)
-        json_object_set_new(o, "prediction",
-                            json_pack("{s:i, s:s, s:f, s:b}", "class", t->pred.cls, "name",
-                                      t->pred.name, "confidence", t->pred.confidence, "fooled",
-                                      t->pred.fooled));
+        json_object_set_new(
+            o, "prediction",
+            json_pack("{s:i, s:s, s:o, s:b}", "class", t->pred.cls, "name", t->pred.name,
+                      "confidence", vf_json_number(t->pred.confidence), "fooled", t->pred.fooled));
     if (t->preview.data) {
         char name[48];
         snprintf(name, sizeof name, "previews/target_%02d.png", i);
@@ -270,10 +277,13 @@ static vf_status write_csv(const export_run *run, const char *path)
                 w->look_at[0], w->look_at[1], w->look_at[2]);
         if (run->metres > 0)
             fprintf(f, "%.6g", to_metres(run, w->distance));
-        if (t->pred.cls >= 0)
-            fprintf(f, ",%d,\"%s\",%d", t->pred.cls, t->pred.name, t->pred.fooled);
-        else
+        if (t->pred.cls >= 0) {
+            fprintf(f, ",%d", t->pred.cls);
+            vf_csv_next(f, t->pred.name);
+            fprintf(f, ",%d", t->pred.fooled);
+        } else {
             fprintf(f, ",,,");
+        }
         if (run->has_colmap)
             fprintf(f, ",%.9g,%.9g,%.9g\n", t->c2w_colmap[3], t->c2w_colmap[7], t->c2w_colmap[11]);
         else
@@ -299,7 +309,7 @@ static vf_status write_outputs(export_run *run, const char *dir, json_t **summar
         "up, looking along -z); object frame z up, object at the origin; "
         "azimuth about +z from -y, counterclockwise seen from above",
         "units", run->metres > 0 ? "scene units and metres" : "scene units", "metres_per_unit",
-        run->metres > 0 ? json_real(run->metres) : json_null(), "targets", list);
+        run->metres > 0 ? vf_json_number(run->metres) : json_null(), "targets", list);
     if (status == VF_OK &&
         (status = vf_path_join(path, sizeof path, dir, "targets.json")) == VF_OK)
         status = vf_json_save(path, doc);

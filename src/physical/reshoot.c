@@ -10,6 +10,7 @@
 #include "vf/export.h"
 #include "vf/calib.h"
 #include "vf/frames.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/overlay.h"
 #include "vf/targets.h"
@@ -45,10 +46,11 @@ static vf_status save_frame(reshoot_run *run, const vf_rgb8 *frame, const vf_fra
         status = vf_rgb8_save(path, frame);
     if (status == VF_OK)
         json_array_append_new(
-            run->saved, json_pack("{s:s, s:s, s:o, s:o, s:i, s:f, s:f}", "file", name, "source",
-                                  info->name, "viewpoint", vf_viewpoint_json(&r->viewpoint),
-                                  "c2w_object", vf_json_mat4(r->c2w_object), "inliers", r->inliers,
-                                  "reprojection_px", r->reprojection_px, "box_distance", box));
+            run->saved,
+            json_pack("{s:s, s:s, s:o, s:o, s:i, s:o, s:o}", "file", name, "source", info->name,
+                      "viewpoint", vf_viewpoint_json(&r->viewpoint), "c2w_object",
+                      vf_json_mat4(r->c2w_object), "inliers", r->inliers, "reprojection_px",
+                      vf_json_number(r->reprojection_px), "box_distance", vf_json_number(box)));
     return status;
 }
 
@@ -92,7 +94,7 @@ static vf_status handle_frame(reshoot_run *run, const vf_rgb8 *frame, const vf_f
         snprintf(line, sizeof line, "%s%s", keep ? "ON TARGET, saved; " : "", text);
         json_object_set_new(entry, "advice", json_string(text));
         json_object_set_new(entry, "on_target", json_boolean(keep));
-        json_object_set_new(entry, "box_distance", json_real(box_smooth));
+        json_object_set_new(entry, "box_distance", vf_json_number(box_smooth));
         json_object_set_new(entry, "viewpoint", vf_viewpoint_json(&r.viewpoint));
     }
     if (run->on_frame)
@@ -153,7 +155,7 @@ static vf_status reshoot(const vf_reshoot_options *o, vf_workspace *ws, reshoot_
     if (status == VF_OK)
         status = vf_targets_workspace_target(ws->root, o->target, &run->target_v, run->target_c2w);
     if (status == VF_OK)
-        status = vf_localizer_open(ws->root, &o->loc, &run->loc);
+        status = vf_localizer_open(ws, &o->loc, &run->loc);
     if (status != VF_OK)
         return status;
     if (!vf_workspace_metres_per_unit(ws, &run->metres))
@@ -174,9 +176,9 @@ static vf_status reshoot(const vf_reshoot_options *o, vf_workspace *ws, reshoot_
         status = stopped;
     else if (stopped != VF_OK)
         snprintf(stop_message, sizeof stop_message, "%s", vf_error_message());
-    json_t *doc = json_pack("{s:i, s:o, s:f, s:O}", "target", o->target, "target_viewpoint",
+    json_t *doc = json_pack("{s:i, s:o, s:o, s:O}", "target", o->target, "target_viewpoint",
                             vf_viewpoint_json(&run->target_v), "tolerance_percent",
-                            100 * o->tolerance, "frames", run->saved);
+                            vf_json_number(100 * o->tolerance), "frames", run->saved);
     if (stop_message[0])
         json_object_set_new(doc, "stopped_early", json_string(stop_message));
     if (status == VF_OK &&
@@ -188,11 +190,12 @@ static vf_status reshoot(const vf_reshoot_options *o, vf_workspace *ws, reshoot_
                                               (int)json_array_size(run->saved)));
     run->result = doc;
     if (status == VF_OK)
-        status = vf_stage_commit(
-            &stage,
-            json_pack("{s:i, s:f}", "target", o->target, "tolerance_percent", 100 * o->tolerance),
-            json_pack("{s:i, s:i, s:i}", "frames", run->seen, "localized", run->localized, "saved",
-                      (int)json_array_size(run->saved)));
+        status =
+            vf_stage_commit(&stage,
+                            json_pack("{s:i, s:o}", "target", o->target, "tolerance_percent",
+                                      vf_json_number(100 * o->tolerance)),
+                            json_pack("{s:i, s:i, s:i}", "frames", run->seen, "localized",
+                                      run->localized, "saved", (int)json_array_size(run->saved)));
     else
         vf_stage_abort(&stage);
     if (status == VF_OK && stop_message[0])

@@ -10,8 +10,10 @@
 #include "vf/attack_file.h"
 #include "vf/export.h"
 #include "vf/classifier.h"
+#include "vf/csv.h"
 #include "vf/field.h"
 #include "vf/frames.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/object3d.h"
 #include "vf/plot.h"
@@ -192,7 +194,7 @@ static vf_status score_frame(score_run *run, const vf_rgb8 *frame, const vf_fram
     vf_status status = vf_score_frame(frame, &s);
     if (status != VF_OK)
         return status;
-    json_object_set_new(row, "sharpness", json_real(s.sharpness));
+    json_object_set_new(row, "sharpness", vf_json_number(s.sharpness));
     if (s.sharpness < run->sharpness_threshold) {
         run->blurry++;
         json_object_set_new(row, "status", json_string("blurry"));
@@ -213,7 +215,7 @@ static vf_status score_frame(score_run *run, const vf_rgb8 *frame, const vf_fram
     int inside = vf_viewpoint_within(&r.viewpoint, &run->center, run->attack.range,
                                      run->opt->tolerance, &worst);
     json_object_set_new(row, "viewpoint", vf_viewpoint_json(&r.viewpoint));
-    json_object_set_new(row, "box_distance", json_real(worst));
+    json_object_set_new(row, "box_distance", vf_json_number(worst));
     int top;
     float p;
     double coverage;
@@ -234,10 +236,10 @@ static vf_status score_frame(score_run *run, const vf_rgb8 *frame, const vf_fram
         run->fooled[run->sheet_count++] = !vf_attack_is_label(&run->attack, top);
     }
     if (run->object_mode)
-        json_object_set_new(row, "object_coverage", json_real(coverage));
+        json_object_set_new(row, "object_coverage", vf_json_number(coverage));
     json_object_set_new(row, "class", json_integer(top));
     json_object_set_new(row, "class_name", json_string(vf_class_short_name(top)));
-    json_object_set_new(row, "confidence", json_real(p));
+    json_object_set_new(row, "confidence", vf_json_number(p));
     json_object_set_new(row, "fooled", json_boolean(!vf_attack_is_label(&run->attack, top)));
     if (inside) {
         count(&run->kept, &run->attack, top);
@@ -284,26 +286,28 @@ static json_t *tally_json(const tally *t, const char *rate_name)
             json_array_append_new(classes,
                                   json_pack("{s:i, s:s, s:i}", "class", c, "name",
                                             vf_class_short_name(c), "frames", t->class_count[c]));
-    return json_pack("{s:i, s:i, s:f, s:[f,f], s:o}", "frames", t->frames, "misclassified",
+    /* No frame, no rate: null, never a 0% that reads like a measurement. */
+    return json_pack("{s:i, s:i, s:o, s:[o,o], s:o}", "frames", t->frames, "misclassified",
                      t->misclassified, rate_name,
-                     t->frames ? (double)t->misclassified / t->frames : 0.0, "interval95", lo, hi,
-                     "predicted", classes);
+                     t->frames ? vf_json_number((double)t->misclassified / t->frames) : json_null(),
+                     "interval95", vf_json_number(lo), vf_json_number(hi), "predicted", classes);
 }
 
 static json_t *result_json(const score_run *run)
 {
     const vf_score_options *o = run->opt;
     return json_pack(
-        "{s:s, s:s, s:o, s:f, s:s, s:s, s:s, s:o, s:o, s:{s:i, s:i, s:i, s:i}, "
-        "s:i, s:f, s:s}",
+        "{s:s, s:s, s:o, s:o, s:s, s:s, s:s, s:o, s:o, s:{s:i, s:i, s:i, s:i}, "
+        "s:i, s:o, s:s}",
         "workspace", run->root, "center", run->center_name, "center_viewpoint",
-        vf_viewpoint_json(&run->center), "tolerance_percent", 100 * o->tolerance, "model",
-        vf_classifier_path(run->cls), "engine", vf_classifier_engine(run->cls), "label",
+        vf_viewpoint_json(&run->center), "tolerance_percent", vf_json_number(100 * o->tolerance),
+        "model", vf_classifier_path(run->cls), "engine", vf_classifier_engine(run->cls), "label",
         run->attack.label_text, "kept", tally_json(&run->kept, "asr"), "natural",
-        tally_json(&run->natural, "error_rate"), "rejected", "blurry", run->blurry,
-        "not_localized", run->not_localized, "out_of_tolerance", run->out_of_tolerance, "total",
-        run->total, "frames", run->total, "localize_fps",
-        run->localize_seconds > 0 ? (run->total - run->blurry) / run->localize_seconds : 0.0,
+        tally_json(&run->natural, "error_rate"), "rejected", "blurry", run->blurry, "not_localized",
+        run->not_localized, "out_of_tolerance", run->out_of_tolerance, "total", run->total,
+        "frames", run->total, "localize_fps",
+        vf_json_number(
+            run->localize_seconds > 0 ? (run->total - run->blurry) / run->localize_seconds : 0.0),
         "mode", run->object_mode ? "object" : "scene");
 }
 
@@ -320,20 +324,21 @@ static vf_status write_frames_csv(const char *path, const json_t *frames)
     json_array_foreach(frames, i, row)
     {
         json_t *v = json_object_get(row, "viewpoint");
-        fprintf(f, "\"%s\",%s", json_string_value(json_object_get(row, "frame")),
-                json_string_value(json_object_get(row, "status")));
+        vf_csv_text(f, json_string_value(json_object_get(row, "frame")));
+        vf_csv_next(f, json_string_value(json_object_get(row, "status")));
         for (int k = 0; k < 6; k++)
             if (v)
                 fprintf(f, ",%.6g", json_number_value(json_array_get(v, (size_t)k)));
             else
                 fputc(',', f);
         json_t *cls = json_object_get(row, "class");
-        if (cls)
-            fprintf(f, ",%lld,\"%s\",%d\n", json_integer_value(cls),
-                    json_string_value(json_object_get(row, "class_name")),
-                    json_is_true(json_object_get(row, "fooled")));
-        else
+        if (cls) {
+            fprintf(f, ",%lld", json_integer_value(cls));
+            vf_csv_next(f, json_string_value(json_object_get(row, "class_name")));
+            fprintf(f, ",%d\n", json_is_true(json_object_get(row, "fooled")));
+        } else {
             fprintf(f, ",,,\n");
+        }
     }
     fclose(f);
     vf_status status = vf_write_file_atomic(path, text, size);
@@ -362,8 +367,9 @@ static vf_status save_results(vf_workspace *ws, const score_run *run, json_t *re
                                   run->fooled, run->sheet_count, 6);
     if (status == VF_OK)
         status = vf_stage_commit(&stage,
-                                 json_pack("{s:f, s:s}", "tolerance_percent",
-                                           100 * run->opt->tolerance, "center", run->center_name),
+                                 json_pack("{s:o, s:s}", "tolerance_percent",
+                                           vf_json_number(100 * run->opt->tolerance), "center",
+                                           run->center_name),
                                  json_deep_copy(result));
     else
         vf_stage_abort(&stage);
@@ -400,13 +406,20 @@ vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
     if (status == VF_OK)
         status = open_classifier(&run);
     if (status == VF_OK)
-        status = vf_localizer_open(ws->root, &o->loc, &run.loc);
+        status = vf_localizer_open(ws, &o->loc, &run.loc);
     if (status == VF_OK)
         status = open_object_mode(&run, ws);
     if (status == VF_OK)
         status = measure_sharpness(&run);
     if (status == VF_OK)
         status = score_frames(&run);
+    if (status == VF_OK && run.kept.frames == 0) /* a failed measurement: nothing committed */
+        status = vf_fail(VF_EINPUT,
+                         "no measurement: none of the %d frames is within %.1f%% of %s (%d blurry, "
+                         "%d not localized, %d out of tolerance); re-shoot nearer it ('vfcapture "
+                         "reshoot') or widen --tolerance",
+                         run.total, 100 * o->tolerance, run.center_name, run.blurry,
+                         run.not_localized, run.out_of_tolerance);
     if (status == VF_OK) {
         *out = result_json(&run);
         status = save_results(ws, &run, *out);
@@ -426,6 +439,33 @@ vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
     }
     return status;
 }
+/* ---- reading score.json ---- */
+
+vf_status vf_score_load(const vf_workspace *ws, json_t **doc)
+{
+    *doc = NULL;
+    char path[VF_PATH_MAX];
+    double center[VF_VIEW_DIM];
+    vf_status status = vf_workspace_need(ws, "score");
+    if (status == VF_OK)
+        status = vf_workspace_path(ws, "score", "score.json", path, sizeof path);
+    if (status == VF_OK)
+        status = vf_json_load(path, doc);
+    if (status == VF_OK &&
+        (!vf_json_read_doubles(json_object_get(*doc, "center_viewpoint"), center, VF_VIEW_DIM) ||
+         !(json_number_value(json_object_get(*doc, "tolerance_percent")) > 0) ||
+         !json_is_object(json_object_get(*doc, "kept")) ||
+         !json_is_array(json_object_get(*doc, "frames_detail"))))
+        status = vf_fail(VF_EINPUT, "%s is not what score writes (center_viewpoint, "
+                                    "tolerance_percent, kept, frames_detail)",
+                         path);
+    if (status != VF_OK) {
+        json_decref(*doc);
+        *doc = NULL;
+    }
+    return status;
+}
+
 /* ---- the summary across workspaces ---- */
 
 static double nan_to(double x) { return isnan(x) ? -1 : x; }
@@ -434,7 +474,6 @@ static double nan_to(double x) { return isnan(x) ? -1 : x; }
  * physical ones (`score`); at least one of the last two must be there. */
 static vf_status summary_row(const char *root, json_t *rows)
 {
-    char path[VF_PATH_MAX];
     vf_attack_file a = {0};
     vf_real_rates real = {NAN, NAN, NAN};
     json_t *score = NULL;
@@ -446,9 +485,8 @@ static vf_status summary_row(const char *root, json_t *rows)
     status = vf_attack_file_load_workspace(&ws, vf_export_attack(&ws), &a);
     if (status == VF_OK)
         status = vf_real_load_rates(&ws, a.stage, &real, &has_real);
-    if (status == VF_OK && vf_workspace_has_stage(&ws, "score") &&
-        (status = vf_workspace_path(&ws, "score", "score.json", path, sizeof path)) == VF_OK)
-        status = vf_json_load(path, &score);
+    if (status == VF_OK && vf_workspace_has_stage(&ws, "score"))
+        status = vf_score_load(&ws, &score);
     if (status == VF_OK && !score && !has_real)
         status = vf_fail(VF_EINPUT,
                          "%s has no score (run 'vfcapture score %s VIDEO') and no "
@@ -460,12 +498,14 @@ static vf_status summary_row(const char *root, json_t *rows)
         vf_path_basename(name, sizeof name, root, 0);
         json_t *kept = json_object_get(score, "kept");
         json_t *row =
-            json_pack("{s:s, s:s, s:f, s:f, s:f, s:f, s:f, s:f}", "object", name, "label",
-                      a.label_text, "natural_accuracy", nan_to(a.natural_accuracy), "asr_v_star",
-                      nan_to(a.asr_v_star), "asr_samples", nan_to(a.asr_samples),
-                      "real_natural_accuracy", nan_to(real.natural_accuracy), "real_asr_v_star",
-                      nan_to(real.asr_v_star), "real_asr_samples", nan_to(real.asr_samples));
-        if (kept)
+            json_pack("{s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:o}", "object", name, "label",
+                      a.label_text, "natural_accuracy", vf_json_number(nan_to(a.natural_accuracy)),
+                      "asr_v_star", vf_json_number(nan_to(a.asr_v_star)), "asr_samples",
+                      vf_json_number(nan_to(a.asr_samples)), "real_natural_accuracy",
+                      vf_json_number(nan_to(real.natural_accuracy)), "real_asr_v_star",
+                      vf_json_number(nan_to(real.asr_v_star)), "real_asr_samples",
+                      vf_json_number(nan_to(real.asr_samples)));
+        if (json_integer_value(json_object_get(kept, "frames")) > 0)
             json_object_update_new(row,
                                    json_pack("{s:O, s:O, s:O, s:O}", "physical_asr",
                                              json_object_get(kept, "asr"), "interval95",

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "vf/attack_file.h"
+#include "vf/json.h"
 #include "vf/workspace.h"
 
 #define DEG (180.0 / M_PI)
@@ -49,7 +50,9 @@ vf_status vf_targets_workspace_target(const char *ws_root, int n, vf_viewpoint *
 
 json_t *vf_viewpoint_json(const vf_viewpoint *v)
 {
-    return json_pack("[f,f,f,f,f,f]", v->psi, v->theta, v->phi, v->dx, v->dy, v->dz);
+    return json_pack("[o,o,o,o,o,o]", vf_json_number(v->psi), vf_json_number(v->theta),
+                     vf_json_number(v->phi), vf_json_number(v->dx), vf_json_number(v->dy),
+                     vf_json_number(v->dz));
 }
 
 int vf_viewpoint_within(const vf_viewpoint *v, const vf_viewpoint *center, const double range[6],

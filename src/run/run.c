@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/json.h"
 #include "vf/log.h"
 
 #define MEMORY_FILE "run.json"
@@ -91,9 +92,9 @@ static int plan_stages(const vf_run_options *o, const char *attack_stage, const 
     calls[n++] = (stage_call){
         .name = "train",
         .which = TRAIN,
-        .settings = json_pack("{s:f, s:i}", "minutes",
-                              vf_train_minutes(&o->train, kind == VF_INGEST_MODEL), "steps",
-                              o->train.steps)};
+        .settings = json_pack("{s:o, s:i}", "minutes",
+                              vf_json_number(vf_train_minutes(&o->train, kind == VF_INGEST_MODEL)),
+                              "steps", o->train.steps)};
     if (o->train.object_only) /* the key only when set: older workspaces stay current */
         json_object_set_new(calls[n - 1].settings, "object_only", json_true());
     if (o->train.appearance)
@@ -199,10 +200,10 @@ vf_status vf_run(const char *ws_root, const vf_run_options *options, json_t **su
             vf_workspace_path(&ws, attack_stage, "attack.json", report, sizeof report);
             const json_t *attack =
                 json_object_get(vf_workspace_stage_record(&ws, attack_stage), "summary");
-            *summary = json_pack("{s:s, s:f, s:s, s:O, s:s, s:s}", "workspace", ws.root,
-                                 "seconds", vf_now() - start, "attack_name", name, "attack",
-                                 attack ? attack : json_null(), "shot_card", card,
-                                 "attack_report", report);
+            *summary = json_pack("{s:s, s:o, s:s, s:O, s:s, s:s}", "workspace", ws.root, "seconds",
+                                 vf_json_number(vf_now() - start), "attack_name", name, "attack",
+                                 attack ? attack : json_null(), "shot_card", card, "attack_report",
+                                 report);
         }
     }
     for (int i = 0; i < count; i++)

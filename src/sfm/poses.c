@@ -10,6 +10,7 @@
 #include "poses_internal.h"
 #include "vf/dataset.h"
 #include "vf/ingest.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/normalize.h"
 #include "vf/sfm_export.h"
@@ -158,7 +159,7 @@ static vf_status prepare_frames(poses_run *run, const vf_workspace *ws)
         status = vf_sfm_images_prepare(ingest_images, run->images, white, &run->frames);
     if (status == VF_OK && run->opt->has_intrinsics)
         status = fit_known_camera(&run->frames, &run->opt->known);
-    json_object_set_new(run->seconds, "prepare", json_real(vf_now() - start));
+    json_object_set_new(run->seconds, "prepare", vf_json_number(vf_now() - start));
     if (status == VF_OK && run->frames.count < 3)
         status = vf_fail(VF_EINPUT,
                          "only %d frames in WS/ingest/images: structure from motion "
@@ -188,13 +189,15 @@ static vf_status check_registration(const poses_run *run)
 static json_t *check_json(const poses_check *c)
 {
     const vf_pose_agreement *g = &c->agreement;
-    json_t *j = json_pack("{s:s, s:i, s:i, s:f}", "verdict", c->verdict, "sampled", c->sampled,
-                          "registered", c->registered, "seconds", c->seconds);
+    json_t *j = json_pack("{s:s, s:i, s:i, s:o}", "verdict", c->verdict, "sampled", c->sampled,
+                          "registered", c->registered, "seconds", vf_json_number(c->seconds));
     if (c->registered >= 3)
-        json_object_update_new(j, json_pack("{s:f, s:f, s:f, s:i, s:f}", "rotation_median_deg",
-                                            g->rot_median, "rotation_p90_deg", g->rot_p90,
-                                            "rotation_max_deg", g->rot_max, "over_5deg",
-                                            g->rot_over_5deg, "position_median", g->pos_median));
+        json_object_update_new(j,
+                               json_pack("{s:o, s:o, s:o, s:i, s:o}", "rotation_median_deg",
+                                         vf_json_number(g->rot_median), "rotation_p90_deg",
+                                         vf_json_number(g->rot_p90), "rotation_max_deg",
+                                         vf_json_number(g->rot_max), "over_5deg", g->rot_over_5deg,
+                                         "position_median", vf_json_number(g->pos_median)));
     return j;
 }
 
@@ -331,7 +334,7 @@ static json_t *cameras_json(const vf_colmap_model *m)
         const vf_colmap_camera *c = &m->cameras[i];
         json_t *params = json_array();
         for (int k = 0; k < c->param_count; k++)
-            json_array_append_new(params, json_real(c->params[k]));
+            json_array_append_new(params, vf_json_number(c->params[k]));
         json_array_append_new(list, json_pack("{s:i, s:s, s:i, s:i, s:o}", "id", c->id, "model",
                                               c->model, "width", c->width, "height", c->height,
                                               "params", params));
@@ -355,20 +358,20 @@ static json_t *unregistered_json(const poses_run *run)
 static json_t *summarize(const poses_run *run, const vf_normalization *norm)
 {
     const vf_colmap_model *m = &run->model;
-    json_t *j = json_pack("{s:i, s:i, s:i, s:o, s:f, s:i, s:s, s:s, s:o, s:s, s:s, s:f, s:O}",
-                          "registered", m->image_count, "total", run->frames.count, "models",
-                          run->model_count, "unregistered", unregistered_json(run),
-                          "reprojection_error_px", vf_colmap_model_reprojection_error(m), "points",
-                          m->point_count, "matcher", run->matcher, "camera_model",
-                          run->camera_model, "cameras", cameras_json(m), "up_method",
-                          norm->up_method, "center_method", norm->center_method, "scale_to_object",
-                          norm->object_from_world.scale, "seconds", run->seconds);
+    json_t *j = json_pack(
+        "{s:i, s:i, s:i, s:o, s:o, s:i, s:s, s:s, s:o, s:s, s:s, s:o, s:O}", "registered",
+        m->image_count, "total", run->frames.count, "models", run->model_count, "unregistered",
+        unregistered_json(run), "reprojection_error_px",
+        vf_json_number(vf_colmap_model_reprojection_error(m)), "points", m->point_count, "matcher",
+        run->matcher, "camera_model", run->camera_model, "cameras", cameras_json(m), "up_method",
+        norm->up_method, "center_method", norm->center_method, "scale_to_object",
+        vf_json_number(norm->object_from_world.scale), "seconds", run->seconds);
     json_object_set(j, "check", run->check ? run->check : json_null());
     json_object_set_new(j, "mapping", json_string(run->posed     ? "known poses"
                                                   : run->relaxed ? "relaxed"
                                                                  : "default"));
     if (run->posed) /* how well the set's poses fit its photos (poses_known.c) */
-        json_object_set_new(j, "matches_explained", json_real(run->explained));
+        json_object_set_new(j, "matches_explained", vf_json_number(run->explained));
     if (run->fallback) /* the matcher first chosen, whose model was not trusted */
         json_object_set_new(j, "fallback_from", json_string(run->fallback));
     return j;
@@ -416,7 +419,8 @@ static vf_status run_stage(poses_run *run, const vf_workspace *ws, json_t **summ
     if (status == VF_OK)
         status = export_outputs(run, &norm);
     if (status == VF_OK) {
-        json_object_set_new(run->seconds, "total", json_real(vf_now() - run->stage.start_time));
+        json_object_set_new(run->seconds, "total",
+                            vf_json_number(vf_now() - run->stage.start_time));
         *summary = summarize(run, &norm);
         status = vf_remove_tree(run->scratch);
     }
@@ -442,9 +446,9 @@ vf_status vf_poses_run(vf_workspace *ws, const vf_poses_options *o, json_t **sum
     vf_colmap_close(&run.colmap);
     if (status == VF_OK) {
         json_t *params =
-            json_pack("{s:s, s:s, s:i, s:i, s:f, s:b, s:b}", "matcher", opt.matcher,
-                      "camera_model", opt.camera_model, "overlap", opt.overlap, "max_features",
-                      opt.max_features, "min_registered", opt.min_registered, "known_intrinsics",
+            json_pack("{s:s, s:s, s:i, s:i, s:o, s:b, s:b}", "matcher", opt.matcher, "camera_model",
+                      opt.camera_model, "overlap", opt.overlap, "max_features", opt.max_features,
+                      "min_registered", vf_json_number(opt.min_registered), "known_intrinsics",
                       opt.has_intrinsics, "check", opt.check);
         status = vf_stage_commit(&run.stage, params, json_deep_copy(*summary));
     } else {
@@ -470,11 +474,8 @@ vf_status vf_poses_move_set_frames(const vf_workspace *ws, vf_dataset *ds, int *
     const char *mapping = json_string_value(json_object_get(summary, "mapping"));
     if (!vf_workspace_has_stage(ws, "poses") || !mapping || strcmp(mapping, "known poses"))
         return VF_OK;
-    char path[VF_PATH_MAX];
     vf_similarity object_from_set;
-    vf_status status = vf_workspace_path(ws, "poses", VF_NORMALIZATION_FILE, path, sizeof path);
-    if (status == VF_OK)
-        status = vf_normalization_load(path, &object_from_set, NULL);
+    vf_status status = vf_normalization_load_workspace(ws, &object_from_set, NULL, NULL);
     for (int i = 0; status == VF_OK && i < ds->count; i++) {
         double c2w[16];
         vf_similarity_apply_c2w(&object_from_set, ds->frames[i].c2w, c2w);

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "poses_internal.h"
+#include "vf/json.h"
 #include "vf/log.h"
 
 /* Run one COLMAP command and record its wall time under its name, or under "check" while
@@ -19,7 +20,7 @@ vf_status vf__poses_run_step(poses_run *run, const char *label, vf_args *args)
                                      &seconds);
     const char *name = run->checking ? "check" : args->count ? args->items[0] : "colmap";
     json_t *before = json_object_get(run->seconds, name);
-    json_object_set_new(run->seconds, name, json_real(seconds + json_number_value(before)));
+    json_object_set_new(run->seconds, name, vf_json_number(seconds + json_number_value(before)));
     vf_args_free(args);
     return status;
 }

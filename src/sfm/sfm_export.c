@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/fsutil.h"
+#include "vf/json.h"
 #include "vf/workspace.h"
 
 static int compare_image_names(const void *a, const void *b)
@@ -94,24 +96,26 @@ static json_t *similarity_json(const vf_similarity *s)
     for (int r = 0; r < 3; r++)
         json_array_append_new(rotation, vf_json_doubles(s->R + 3 * r, 3));
     for (int r = 0; r < 4; r++)
-        json_array_append_new(matrix, json_pack("[f,f,f,f]", m[4 * r], m[4 * r + 1],
-                                                m[4 * r + 2], m[4 * r + 3]));
-    return json_pack("{s:f, s:o, s:o, s:o}", "scale", s->scale, "rotation", rotation,
-                     "translation", vf_json_doubles(s->t, 3), "matrix", matrix);
+        json_array_append_new(
+            matrix, json_pack("[o,o,o,o]", vf_json_number(m[4 * r]), vf_json_number(m[4 * r + 1]),
+                              vf_json_number(m[4 * r + 2]), vf_json_number(m[4 * r + 3])));
+    return json_pack("{s:o, s:o, s:o, s:o}", "scale", vf_json_number(s->scale), "rotation",
+                     rotation, "translation", vf_json_doubles(s->t, 3), "matrix", matrix);
 }
 
 vf_status vf_sfm_save_normalization(const char *path, const vf_normalization *norm)
 {
     vf_similarity inverse = vf_similarity_inverse(&norm->object_from_world);
     json_t *doc = json_pack(
-        "{s:s, s:o, s:o, s:o, s:s, s:o, s:s, s:f, s:f}", "convention",
+        "{s:s, s:o, s:o, s:o, s:s, s:o, s:s, s:o, s:o}", "convention",
         "x_to = scale * rotation * x_from + translation (matrix: the same as a 4x4); the object "
         "frame has z up, the object at the origin and cameras at a mean distance of 4",
         "object_from_colmap", similarity_json(&norm->object_from_world), "colmap_from_object",
         similarity_json(&inverse), "up_colmap", vf_json_doubles(norm->up_world, 3), "up_method",
         norm->up_method, "center_colmap", vf_json_doubles(norm->center_world, 3), "center_method",
-        norm->center_method, "colmap_mean_camera_distance", norm->world_distance,
-        "object_mean_camera_distance", norm->world_distance * norm->object_from_world.scale);
+        norm->center_method, "colmap_mean_camera_distance", vf_json_number(norm->world_distance),
+        "object_mean_camera_distance",
+        vf_json_number(norm->world_distance * norm->object_from_world.scale));
     if (!doc)
         return vf_fail(VF_EINTERNAL, "cannot encode %s", path);
     vf_status status = vf_json_save(path, doc);
@@ -173,4 +177,20 @@ vf_status vf_normalization_load(const char *path, vf_similarity *object_from_col
     if (colmap_from_object)
         *colmap_from_object = back;
     return VF_OK;
+}
+
+vf_status vf_normalization_load_workspace(const vf_workspace *ws,
+                                          vf_similarity *object_from_colmap,
+                                          vf_similarity *colmap_from_object, int *found)
+{
+    char path[VF_PATH_MAX];
+    vf_status status = vf_workspace_path(ws, "poses", VF_NORMALIZATION_FILE, path, sizeof path);
+    if (found)
+        *found = status == VF_OK && vf_is_file(path);
+    if (status != VF_OK || (found && !*found))
+        return status;
+    if (!vf_is_file(path))
+        return vf_fail(VF_EINPUT, "%s is missing: run 'vfcapture poses %s' again", path,
+                       ws->root);
+    return vf_normalization_load(path, object_from_colmap, colmap_from_object);
 }

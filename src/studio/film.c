@@ -151,17 +151,14 @@ vf_status vf__film(const vf_object3d *obj, const vf_studio_phone *phone, const d
         status = vf_studio_truth_path(video, truth_path, sizeof truth_path);
     json_t *frames = json_array();
     for (int i = 0; i < n; i++) {
-        json_t *f = json_pack("{s:i, s:f, s:o}", "index", i, "time", i / phone->fps, "c2w",
-                              vf_json_doubles(c2w + 16 * i, 16));
+        json_t *f = json_pack("{s:i, s:o, s:o}", "index", i, "time", vf_json_number(i / phone->fps),
+                              "c2w", vf_json_doubles(c2w + 16 * i, 16));
         if (extra)
             json_object_update(f, json_array_get(extra, (size_t)i));
         json_array_append_new(frames, f);
     }
-    json_object_set_new(truth, "camera",
-                        json_pack("{s:i, s:i, s:f, s:f, s:f, s:f}", "width", cam.width, "height",
-                                  cam.height, "fx", cam.fx, "fy", cam.fy, "cx", cam.cx, "cy",
-                                  cam.cy));
-    json_object_set_new(truth, "fps", json_real(phone->fps));
+    json_object_set_new(truth, "camera", vf_camera_json(&cam));
+    json_object_set_new(truth, "fps", vf_json_number(phone->fps));
     json_object_set_new(truth, "frames", frames);
     if (status == VF_OK)
         status = keep_renders_for(work, render_dir, truth);
@@ -202,14 +199,16 @@ vf_status vf__film(const vf_object3d *obj, const vf_studio_phone *phone, const d
         status = vf__encode(film_dir, phone->fps, video, work);
 
     json_object_set_new(truth, "transform",
-                        json_pack("{s:[f,f,f], s:f}", "center", fit.center[0], fit.center[1],
-                                  fit.center[2], "scale", fit.scale));
+                        json_pack("{s:[o,o,o], s:o}", "center", vf_json_number(fit.center[0]),
+                                  vf_json_number(fit.center[1]), vf_json_number(fit.center[2]),
+                                  "scale", vf_json_number(fit.scale)));
     if (status == VF_OK)
         status = vf_json_save(truth_path, truth);
     if (status == VF_OK && report)
-        *report = json_pack("{s:s, s:s, s:i, s:f, s:f, s:i, s:i}", "video", video, "truth",
-                            truth_path, "frames", n, "seconds", n / phone->fps, "render_seconds",
-                            render_seconds, "width", cam.width, "height", cam.height);
+        *report =
+            json_pack("{s:s, s:s, s:i, s:o, s:o, s:i, s:i}", "video", video, "truth", truth_path,
+                      "frames", n, "seconds", vf_json_number(n / phone->fps), "render_seconds",
+                      vf_json_number(render_seconds), "width", cam.width, "height", cam.height);
     if (status == VF_OK)
         status = vf_remove_tree(work);
     json_decref(truth);

@@ -239,12 +239,12 @@ static void on_advice(const json_t *entry, const char *line, void *ctx)
     f->on_and_in += on && f->box <= f->opt->tolerance;
     json_array_append_new(
         f->frames,
-        json_pack("{s:i, s:f, s:o, s:o, s:o, s:f, s:i, s:s?, s:b, s:b}", "index", f->filmed,
-                  "time", f->filmed / f->phone->fps, "c2w", vf_json_doubles(f->c2w, 16),
+        json_pack("{s:i, s:o, s:o, s:o, s:o, s:o, s:i, s:s?, s:b, s:b}", "index", f->filmed, "time",
+                  vf_json_number(f->filmed / f->phone->fps), "c2w", vf_json_doubles(f->c2w, 16),
                   "c2w_workspace", vf_json_doubles(ws_c2w, 16), "viewpoint",
-                  vf_viewpoint_json(&truly), "box_distance", f->box, "walk", f->walk, "advice",
-                  json_string_value(json_object_get(entry, "advice")), "on_target", on,
-                  "wrong_way", wrong));
+                  vf_viewpoint_json(&truly), "box_distance", vf_json_number(f->box), "walk",
+                  f->walk, "advice", json_string_value(json_object_get(entry, "advice")),
+                  "on_target", on, "wrong_way", wrong));
     f->filmed++;
     f->step++;
 }
@@ -289,16 +289,16 @@ static vf_status walk(vf_workspace *ws, follow_run *f, const double from[16], js
             (f->first_on >= 0 ? f->first_on : f->step) * dt);
     json_array_append_new(
         walks,
-        json_pack("{s:i, s:o, s:f, s:i, s:i, s:b, s:o, s:o, s:i, s:i, s:f, s:i, s:f}", "walk",
-                  f->walk, "from", vf_viewpoint_json(&start), "from_box_distance", box0,
-                  "frames", f->step, "localized", f->localized, "reached", reached,
-                  "seconds_to_on_target",
-                  f->first_on >= 0 ? json_real(f->first_on * dt) : json_null(),
+        json_pack("{s:i, s:o, s:o, s:i, s:i, s:b, s:o, s:o, s:i, s:i, s:o, s:i, s:o}", "walk",
+                  f->walk, "from", vf_viewpoint_json(&start), "from_box_distance",
+                  vf_json_number(box0), "frames", f->step, "localized", f->localized, "reached",
+                  reached, "seconds_to_on_target",
+                  f->first_on >= 0 ? vf_json_number(f->first_on * dt) : json_null(),
                   "seconds_to_truly_in_box",
-                  f->first_in >= 0 ? json_real(f->first_in * dt) : json_null(),
-                  "on_target_frames", f->on_target_steps, "on_target_truly_in_box",
-                  f->on_and_in, "final_box_distance", f->box, "wrong_way_frames", f->wrong,
-                  "wrong_way_longest_seconds", f->wrong_longest * dt));
+                  f->first_in >= 0 ? vf_json_number(f->first_in * dt) : json_null(),
+                  "on_target_frames", f->on_target_steps, "on_target_truly_in_box", f->on_and_in,
+                  "final_box_distance", vf_json_number(f->box), "wrong_way_frames", f->wrong,
+                  "wrong_way_longest_seconds", vf_json_number(f->wrong_longest * dt)));
     return VF_OK;
 }
 
@@ -373,29 +373,30 @@ vf_status vf__follow(vf_workspace *ws, capture_truth *t, const vf_similarity *to
         json_object_set_new(alignment, "model_to_workspace", vf_json_doubles(m, 16));
         vf_camera c = cam;
         json_t *truth = json_pack(
-            "{s:s, s:s, s:s, s:s, s:s, s:i, s:o, s:O, s:{s:b, s:i, s:f, s:f, s:f, s:f, s:f, "
-            "s:f, s:I}, s:O, s:{s:i, s:i, s:f, s:f, s:f, s:f}, s:f, s:O, s:{s:[f,f,f], s:f}}",
+            "{s:s, s:s, s:s, s:s, s:s, s:i, s:o, s:O, s:{s:b, s:i, s:o, s:o, s:o, s:o, s:o, "
+            "s:o, s:I}, s:O, s:o, s:o, s:O, s:{s:[o,o,o], s:o}}",
             "kind", "vfcapture studio truth", "simulation", "reshoot", "model", t->obj.model,
             "capture_truth", truth_path, "workspace", ws->root, "target", o->target,
             "target_viewpoint", vf_viewpoint_json(&f.target), "alignment", alignment, "walk",
-            "follow", 1, "starts", o->starts, "hold_seconds", o->hold_seconds,
-            "give_up_seconds", o->give_up_seconds, "tolerance", o->tolerance, "shake",
-            phone->shake, "noise", phone->noise, "denoise", phone->denoise, "seed",
-            (json_int_t)phone->seed, "walks", walks, "camera", "width", c.width, "height", c.height, "fx", c.fx, "fy", c.fy, "cx",
-            c.cx, "cy", c.cy, "fps", phone->fps, "frames", f.frames, "transform", "center",
-            t->obj.transform.center[0], t->obj.transform.center[1], t->obj.transform.center[2],
-            "scale", t->obj.transform.scale);
+            "follow", 1, "starts", o->starts, "hold_seconds", vf_json_number(o->hold_seconds),
+            "give_up_seconds", vf_json_number(o->give_up_seconds), "tolerance",
+            vf_json_number(o->tolerance), "shake", vf_json_number(phone->shake), "noise",
+            vf_json_number(phone->noise), "denoise", vf_json_number(phone->denoise), "seed",
+            (json_int_t)phone->seed, "walks", walks, "camera", vf_camera_json(&c), "fps", vf_json_number(phone->fps), "frames", f.frames,
+            "transform", "center", vf_json_number(t->obj.transform.center[0]),
+            vf_json_number(t->obj.transform.center[1]), vf_json_number(t->obj.transform.center[2]),
+            "scale", vf_json_number(t->obj.transform.scale));
         char path[VF_PATH_MAX];
         status = vf_studio_truth_path(video, path, sizeof path);
         if (status == VF_OK)
             status = truth ? vf_json_save(path, truth) : vf_fail(VF_EINTERNAL, "out of memory");
         json_decref(truth);
         if (status == VF_OK && report)
-            *report = json_pack("{s:s, s:s, s:i, s:f, s:f, s:i, s:i, s:O, s:i, s:O}", "video",
-                                video, "truth", path, "frames", f.filmed, "seconds",
-                                f.filmed / phone->fps, "render_seconds", vf_now() - started,
-                                "width", c.width, "height", c.height, "walks", walks, "reached",
-                                reached, "alignment", alignment);
+            *report = json_pack(
+                "{s:s, s:s, s:i, s:o, s:o, s:i, s:i, s:O, s:i, s:O}", "video", video, "truth", path,
+                "frames", f.filmed, "seconds", vf_json_number(f.filmed / phone->fps),
+                "render_seconds", vf_json_number(vf_now() - started), "width", c.width, "height",
+                c.height, "walks", walks, "reached", reached, "alignment", alignment);
         if (status == VF_OK)
             status = vf_remove_tree(work);
     }

@@ -16,6 +16,7 @@
 #include "vf/json.h"
 #include "vf/log.h"
 #include "vf/object3d.h"
+#include "vf/score.h"
 #include "vf/stats.h"
 #include "vf/targets.h"
 
@@ -99,13 +100,15 @@ vf_status vf_studio_capture(const char *model, const vf_studio_capture_options *
         return vf_fail(VF_EINTERNAL, "out of memory");
     vf_info("filming %s: %d loops of %.0f s, %d frames %dx%d at %.0f fps", model, o->loops,
             o->loop_seconds, n, o->phone.width, o->phone.height, o->phone.fps);
-    json_t *truth = json_pack(
-        "{s:s, s:s, s:s, s:{s:i, s:f, s:f, s:f, s:f, s:i, s:f, s:f, s:f, s:f, s:I}}", "kind",
-        "vfcapture studio truth", "simulation", "capture", "model", obj.model, "walk", "loops",
-        o->loops, "loop_seconds", o->loop_seconds, "elevation_low", o->elevation_low,
-        "elevation_high", o->elevation_high, "distance", o->distance, "samples", o->phone.samples,
-        "shutter", o->phone.shutter, "shake", o->phone.shake, "noise", o->phone.noise,
-        "denoise", o->phone.denoise, "seed", (json_int_t)o->phone.seed);
+    json_t *truth =
+        json_pack("{s:s, s:s, s:s, s:{s:i, s:o, s:o, s:o, s:o, s:i, s:o, s:o, s:o, s:o, s:I}}",
+                  "kind", "vfcapture studio truth", "simulation", "capture", "model", obj.model,
+                  "walk", "loops", o->loops, "loop_seconds", vf_json_number(o->loop_seconds),
+                  "elevation_low", vf_json_number(o->elevation_low), "elevation_high",
+                  vf_json_number(o->elevation_high), "distance", vf_json_number(o->distance),
+                  "samples", o->phone.samples, "shutter", vf_json_number(o->phone.shutter), "shake",
+                  vf_json_number(o->phone.shake), "noise", vf_json_number(o->phone.noise),
+                  "denoise", vf_json_number(o->phone.denoise), "seed", (json_int_t)o->phone.seed);
     status = vf__film(&obj, &o->phone, c2w, n, NULL, video, truth, report);
     free(c2w);
     return status;
@@ -130,13 +133,8 @@ vf_status vf__truth_load(const char *path, capture_truth *t)
     const json_t *frames = json_object_get(t->doc, "frames");
     const json_t *tr = json_object_get(t->doc, "transform");
     const char *model = json_string_value(json_object_get(t->doc, "model"));
-    t->camera = (vf_camera){
-        .width = (int)json_integer_value(json_object_get(cam, "width")),
-        .height = (int)json_integer_value(json_object_get(cam, "height")),
-        .fx = json_number_value(json_object_get(cam, "fx")),
-        .fy = json_number_value(json_object_get(cam, "fy")),
-        .cx = json_number_value(json_object_get(cam, "cx")),
-        .cy = json_number_value(json_object_get(cam, "cy"))};
+    if (vf_camera_from_json(cam, path, &t->camera) != VF_OK)
+        t->camera = (vf_camera){0}; /* refused below, in one line */
     t->fps = json_number_value(json_object_get(t->doc, "fps"));
     t->count = (int)json_array_size(frames);
     double center[3];
@@ -201,9 +199,9 @@ vf_status vf__align_workspace(const vf_workspace *ws, const capture_truth *t,
     if (status == VF_OK)
         status = vf_pose_compare(ours, ref, n, 0, &agree);
     if (status == VF_OK)
-        *report = json_pack("{s:i, s:f, s:f, s:f}", "frames", n, "scale", s->scale,
-                            "rotation_median_deg", agree.rot_median, "position_median",
-                            agree.pos_median);
+        *report = json_pack("{s:i, s:o, s:o, s:o}", "frames", n, "scale", vf_json_number(s->scale),
+                            "rotation_median_deg", vf_json_number(agree.rot_median),
+                            "position_median", vf_json_number(agree.pos_median));
     free(src);
     free(dst);
     free(ours);
@@ -374,10 +372,10 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
             vf_c2w_to_viewpoint(held_ws, &truly);
             double box;
             vf_viewpoint_within(&truly, &target, attack.range, 1, &box);
-            json_array_append_new(extra, json_pack("{s:o, s:o, s:f}", "c2w_workspace",
-                                                   vf_json_doubles(held_ws, 16),
-                                                   "viewpoint", vf_viewpoint_json(&truly),
-                                                   "box_distance", box));
+            json_array_append_new(extra, json_pack("{s:o, s:o, s:o}", "c2w_workspace",
+                                                   vf_json_doubles(held_ws, 16), "viewpoint",
+                                                   vf_viewpoint_json(&truly), "box_distance",
+                                                   vf_json_number(box)));
         }
     }
     if (status == VF_OK) {
@@ -388,14 +386,16 @@ vf_status vf_studio_reshoot(vf_workspace *ws, const char *model,
         vf_similarity_to_mat4(&to_ws, m);
         json_object_set_new(alignment, "model_to_workspace", vf_json_doubles(m, 16));
         json_t *truth = json_pack(
-            "{s:s, s:s, s:s, s:s, s:s, s:i, s:o, s:O, s:{s:f, s:f, s:f, s:f, s:f, s:f, s:f, "
+            "{s:s, s:s, s:s, s:s, s:s, s:i, s:o, s:O, s:{s:o, s:o, s:o, s:o, s:o, s:o, s:o, "
             "s:I}}",
             "kind", "vfcapture studio truth", "simulation", "reshoot", "model", t.obj.model,
             "capture_truth", truth_path, "workspace", ws->root, "target", o->target,
             "target_viewpoint", vf_viewpoint_json(&target), "alignment", alignment, "walk",
-            "walk_seconds", o->walk_seconds, "hold_seconds", o->hold_seconds, "jitter",
-            o->jitter, "shutter", phone.shutter, "shake", phone.shake, "noise", phone.noise,
-            "denoise", phone.denoise, "seed", (json_int_t)phone.seed);
+            "walk_seconds", vf_json_number(o->walk_seconds), "hold_seconds",
+            vf_json_number(o->hold_seconds), "jitter", vf_json_number(o->jitter), "shutter",
+            vf_json_number(phone.shutter), "shake", vf_json_number(phone.shake), "noise",
+            vf_json_number(phone.noise), "denoise", vf_json_number(phone.denoise), "seed",
+            (json_int_t)phone.seed);
         t.obj.samples = phone.samples;
         status = vf__film(&t.obj, &phone, c2w, n, extra, video, truth, report);
         if (status == VF_OK && report && *report)
@@ -419,22 +419,20 @@ static int same_file(const char *a, const char *b)
 
 vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
 {
-    char truth_path[VF_PATH_MAX], score_path[VF_PATH_MAX];
+    char truth_path[VF_PATH_MAX];
     json_t *truth = NULL, *score = NULL;
     vf_attack_file attack = {0};
     vf_status status = vf_studio_truth_path(video, truth_path, sizeof truth_path);
     if (status == VF_OK && !vf_is_file(truth_path))
         status = vf_fail(VF_EINPUT, "no truth file %s: check a video of `vfcapture simulate "
                                     "reshoot`", truth_path);
-    if (status == VF_OK)
-        status = vf_path_join(score_path, sizeof score_path, ws->root, "score/score.json");
-    if (status == VF_OK && !vf_is_file(score_path))
+    if (status == VF_OK && !vf_workspace_has_stage(ws, "score"))
         status = vf_fail(VF_EINPUT, "%s has no score yet: run 'vfcapture score %s %s' first",
                          ws->root, ws->root, video);
     if (status == VF_OK)
         status = vf_json_load(truth_path, &truth);
     if (status == VF_OK)
-        status = vf_json_load(score_path, &score);
+        status = vf_score_load(ws, &score);
     if (status == VF_OK)
         status = vf_attack_file_load_workspace(ws, vf_export_attack(ws), &attack);
     const json_t *frames = json_object_get(truth, "frames");
@@ -443,9 +441,8 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
     double tolerance = json_number_value(json_object_get(score, "tolerance_percent")) / 100;
     if (status == VF_OK &&
         (!vf_json_read_doubles(json_object_get(score, "center_viewpoint"), center, VF_VIEW_DIM) ||
-         !(tolerance > 0) || !json_is_array(rows) || !json_is_array(frames)))
-        status = vf_fail(VF_EINPUT, "%s or %s is not what the studio and score write",
-                         score_path, truth_path);
+         !json_is_array(frames)))
+        status = vf_fail(VF_EINPUT, "%s is not what the studio writes", truth_path);
     size_t n = json_array_size(rows);
     /* per frame: localization errors, the true box distance, score's verdict, and how far
      * localization moved the box distance (the noise that decides frames near the edge) */
@@ -518,21 +515,22 @@ vf_status vf_studio_check(vf_workspace *ws, const char *video, json_t **report)
     if (status == VF_OK && report) {
         const json_t *k = json_object_get(score, "kept");
         *report = json_pack(
-            "{s:s, s:s, s:i, s:i, s:f, s:f, s:f, s:i, s:i, s:i, s:i, s:f, s:f, "
+            "{s:s, s:s, s:i, s:i, s:o, s:o, s:o, s:i, s:i, s:i, s:i, s:o, s:o, "
             "s:{s:O, s:O, s:O, s:O}, s:O}",
             "video", video, "truth", truth_path, "frames", seen, "localized", localized,
-            "rotation_median_deg", vf_median(rot, localized), "position_median",
-            vf_median(pos, localized), "tolerance", tolerance, "truly_in_box", truly_in, "kept",
-            kept, "agree", agree, "at_box_edge", edge, "edge_band", band, "agreement",
-            localized - edge > 0 ? (double)agree / (localized - edge) : NAN, "physical", "frames",
-            json_object_get(k, "frames"), "misclassified", json_object_get(k, "misclassified"),
-            "asr", json_object_get(k, "asr"), "interval95", json_object_get(k, "interval95"),
-            "natural", json_object_get(score, "natural"));
+            "rotation_median_deg", vf_json_number(vf_median(rot, localized)), "position_median",
+            vf_json_number(vf_median(pos, localized)), "tolerance", vf_json_number(tolerance),
+            "truly_in_box", truly_in, "kept", kept, "agree", agree, "at_box_edge", edge,
+            "edge_band", vf_json_number(band), "agreement",
+            vf_json_number(localized - edge > 0 ? (double)agree / (localized - edge) : NAN),
+            "physical", "frames", json_object_get(k, "frames"), "misclassified",
+            json_object_get(k, "misclassified"), "asr", json_object_get(k, "asr"), "interval95",
+            json_object_get(k, "interval95"), "natural", json_object_get(score, "natural"));
         json_object_set_new(*report, "real",
-                            real_found ? json_pack("{s:f, s:f, s:f}", "natural_accuracy",
-                                                   real.natural_accuracy, "asr_v_star",
-                                                   real.asr_v_star, "asr_samples",
-                                                   real.asr_samples)
+                            real_found ? json_pack("{s:o, s:o, s:o}", "natural_accuracy",
+                                                   vf_json_number(real.natural_accuracy),
+                                                   "asr_v_star", vf_json_number(real.asr_v_star),
+                                                   "asr_samples", vf_json_number(real.asr_samples))
                                        : json_null());
     }
     free(rot);

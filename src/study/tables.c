@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/csv.h"
 #include "vf/fsutil.h"
 #include "vf/json.h"
 #include "vf/plot.h"
@@ -96,13 +97,11 @@ static const char *at(const table *t, int row, int col)
 static void write_csv(FILE *f, const table *t)
 {
     for (int c = 0; c < t->cols; c++)
-        fprintf(f, "%s%s", c ? "," : "", t->head[c]);
+        (c ? vf_csv_next : vf_csv_text)(f, t->head[c]);
     fputc('\n', f);
     for (int r = 0; r < t->n / t->cols; r++) {
-        for (int c = 0; c < t->cols; c++) {
-            const char *v = at(t, r, c);
-            fprintf(f, strpbrk(v, ",\"\n") ? "%s\"%s\"" : "%s%s", c ? "," : "", v);
-        }
+        for (int c = 0; c < t->cols; c++)
+            (c ? vf_csv_next : vf_csv_text)(f, at(t, r, c));
         fputc('\n', f);
     }
 }
@@ -296,8 +295,9 @@ static int read_bench_costs(study *st, const char *dir, const char *object)
         const char *line = strchr(text, '\n'); /* past the header */
         if (line && sscanf(line + 1, "%lf %*s %lf", &seconds, &rss) == 2)
             json_array_append_new(st->costs,
-                                  json_pack("{s:s, s:s, s:f, s:f}", "object", object, "stage",
-                                            stage, "seconds", seconds, "max_rss_mb", rss));
+                                  json_pack("{s:s, s:s, s:o, s:o}", "object", object, "stage",
+                                            stage, "seconds", vf_json_number(seconds), "max_rss_mb",
+                                            vf_json_number(rss)));
         free(text);
     }
     vf_free_names(names, n);
@@ -315,9 +315,10 @@ static void read_costs(study *st, const vf_workspace *ws, const char *object)
     const char *stage;
     json_t *record;
     json_object_foreach(json_object_get(ws->manifest, "stages"), stage, record)
-        json_array_append_new(st->costs, json_pack("{s:s, s:s, s:f, s:n}", "object", object,
-                                                   "stage", stage, "seconds",
-                                                   number(record, "seconds"), "max_rss_mb"));
+        json_array_append_new(st->costs,
+                              json_pack("{s:s, s:s, s:o, s:n}", "object", object, "stage", stage,
+                                        "seconds", vf_json_number(number(record, "seconds")),
+                                        "max_rss_mb"));
 }
 
 static int folder_name(const char *name)
@@ -451,7 +452,7 @@ static mean_ci group_mean(const study *st, int i, size_t offset, double *scratch
     return mean_of(scratch, group_values(st, i, offset, scratch));
 }
 
-/* ---- the paper's numbers (DESIGN.md, "The paper's numbers") ---- */
+/* ---- the paper's numbers (../shared/DESIGN.md, "The paper's numbers") ---- */
 
 /* Table 1, ResNet-50 | ViT-B/16, R(p*) / R(v*) / Real(v*) (random search: R(p*) only). */
 static const char *paper_table1(const attack_row *r)

@@ -10,8 +10,10 @@
 #include <unistd.h>
 
 #include "vf/attack_file.h"
+#include "vf/csv.h"
 #include "vf/dataset.h"
 #include "vf/field.h"
+#include "vf/json.h"
 #include "vf/log.h"
 #include "vf/pose.h"
 #include "vf/rng.h"
@@ -117,13 +119,14 @@ static vf_status render_split(const vbench_object *o, int object, vf_vbench_spli
                 status = vf_image_save(path, &images[i]);
             json_t *v = json_array();
             for (int d = 0; d < VF_VIEW_DIM; d++)
-                json_array_append_new(v, json_real(views[i][d]));
+                json_array_append_new(v, vf_json_number(views[i][d]));
             json_array_append_new(index, json_pack("{s:s, s:i, s:s, s:o}", "file", file, "object",
                                                    object, "split", split_name(split),
                                                    "viewpoint", v));
-            fprintf(csv, "%s,%s,%s,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f\n", file, o->name,
-                    split_name(split), views[i][0], views[i][1], views[i][2], views[i][3],
-                    views[i][4], views[i][5]);
+            vf_csv_text(csv, file);
+            vf_csv_next(csv, o->name);
+            fprintf(csv, ",%s,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f\n", split_name(split), views[i][0],
+                    views[i][1], views[i][2], views[i][3], views[i][4], views[i][5]);
         }
         *done += (size_t)n;
         vf_progress_update(progress, *done, o->name);

@@ -6,6 +6,7 @@
 
 #include <cairo.h>
 
+#include "vf/csv.h"
 #include "vf/fsutil.h"
 #include "vf/vbench.h"
 
@@ -43,9 +44,10 @@ static vf_status write_csv(const vf_vbench_results *r, const char *path)
         const vf_vbench_row *row = &r->rows[i];
         char model[256];
         model_name(r, row->model, model, sizeof model);
-        fprintf(f, "%s,%s,%s,%d,%d,%.2f\n", model, object_name(r, row->object),
-                row->split == VF_VBENCH_NATURAL ? "natural" : "adversarial", row->correct,
-                row->total, accuracy(row));
+        vf_csv_text(f, model);
+        vf_csv_next(f, object_name(r, row->object));
+        fprintf(f, ",%s,%d,%d,%.2f\n", row->split == VF_VBENCH_NATURAL ? "natural" : "adversarial",
+                row->correct, row->total, accuracy(row));
     }
     return fclose(f) == 0 ? VF_OK : vf_fail(VF_EINPUT, "cannot write %s (disk full?)", path);
 }

@@ -15,10 +15,7 @@
 
 /* ---- small converters ---- */
 
-static json_t *real_or_null(double x)
-{
-    return isfinite(x) ? json_real(x) : json_null();
-}
+static json_t *real_or_null(double x) { return isfinite(x) ? vf_json_number(x) : json_null(); }
 
 /* Read exactly n numbers from a JSON array (null reads as -inf); name is for messages. */
 static vf_status array_to_doubles(const json_t *array, const char *name, double *x, int n)
@@ -207,15 +204,18 @@ json_t *vf_attack_config_to_json(const vf_attack_config *cfg)
     json_t *bounds = json_pack("{s:o, s:o}", "lo", vf_json_doubles(cfg->bounds.lo, VF_VIEW_DIM),
                                "hi", vf_json_doubles(cfg->bounds.hi, VF_VIEW_DIM));
     json_t *json = json_pack(
-        "{s:s, s:o, s:i, s:i, s:f, s:f, s:s, s:f, s:f, s:f}", "method",
+        "{s:s, s:o, s:i, s:i, s:o, s:o, s:s, s:o, s:o, s:o}", "method",
         cfg->method == VF_ATTACK_PEPG ? "pepg" : "nes", "bounds", bounds, "samples", cfg->samples,
-        "steps", cfg->steps, "lambda", cfg->lambda, "lr", cfg->lr, "seed", seed, "sigma_init",
-        cfg->sigma_init, "sigma_min", cfg->sigma_min, "sigma_max", cfg->sigma_max);
-    json_t *more = json_pack("{s:f, s:b, s:i, s:f, s:f, s:f, s:f, s:f, s:f}", "sigma_decay",
-                             cfg->sigma_decay, "antithetic", cfg->antithetic, "components",
-                             cfg->components, "weight_lr", cfg->weight_lr, "adam_beta1",
-                             cfg->adam_beta1, "adam_beta2", cfg->adam_beta2, "momentum",
-                             cfg->momentum, "lr_decay", cfg->lr_decay, "sigma_lr", cfg->sigma_lr);
+        "steps", cfg->steps, "lambda", vf_json_number(cfg->lambda), "lr", vf_json_number(cfg->lr),
+        "seed", seed, "sigma_init", vf_json_number(cfg->sigma_init), "sigma_min",
+        vf_json_number(cfg->sigma_min), "sigma_max", vf_json_number(cfg->sigma_max));
+    json_t *more =
+        json_pack("{s:o, s:b, s:i, s:o, s:o, s:o, s:o, s:o, s:o}", "sigma_decay",
+                  vf_json_number(cfg->sigma_decay), "antithetic", cfg->antithetic, "components",
+                  cfg->components, "weight_lr", vf_json_number(cfg->weight_lr), "adam_beta1",
+                  vf_json_number(cfg->adam_beta1), "adam_beta2", vf_json_number(cfg->adam_beta2),
+                  "momentum", vf_json_number(cfg->momentum), "lr_decay",
+                  vf_json_number(cfg->lr_decay), "sigma_lr", vf_json_number(cfg->sigma_lr));
     json_object_update(json, more);
     json_decref(more);
     return json;
