@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "vf/object3d.h"
+#include "vf/real.h"
 #include "vf/resources.h"
 #include "vf/studio.h"
 

@@ -6,7 +6,12 @@ For every object file of the targets (the ones the link line names, so objects l
 files since moved do not count): the functions and data it defines and those it uses. File A depends on
 file B when A uses a symbol B defines. Prints each cycle (a strongly connected set of two or
 more files) and exits 1 when there is one, so that the layering stays a tree: a module calls
-down into the modules below it, an adapter calls nothing above it."""
+down into the modules below it, an adapter calls nothing above it.
+
+The same is checked between modules (the folders: src/<domain>, calib, pipeline): module A
+depends on module B when a file of A uses a symbol a file of B defines. A stage that joins
+several domains lives above them (src/stages, src/run), so a domain never calls up into one
+that calls it back. `--self-test` checks the checker on a made-up graph with an upward call."""
 import collections
 import os
 import subprocess
@@ -37,7 +42,19 @@ def main(build, targets):
     owner = {s: name for name, d in defines.items() for s in d}
     graph = {n: {owner[s] for s in u if s in owner and owner[s] != n} for n, u in uses.items()}
 
-    # Tarjan's strongly connected components, iteratively
+    file_cycles = report(graph, "files")
+    module_cycles = report(modules_of(graph), "modules")
+    return 1 if file_cycles or module_cycles else 0
+
+
+def module(name):
+    """src/field/stage.c -> field; calib/board.c -> calib; pipeline/cli.c -> pipeline."""
+    parts = name.split("/")
+    return parts[1] if parts[0] == "src" and len(parts) > 2 else parts[0]
+
+
+def cycles_of(graph):
+    """Strongly connected sets of two or more nodes (Tarjan's, iteratively)."""
     index, low, on, stack, cycles, counter = {}, {}, set(), [], [], [0]
     for start in graph:
         if start in index:
@@ -67,12 +84,37 @@ def main(build, targets):
                         break
                 if len(comp) > 1:
                     cycles.append(sorted(comp))
+    return cycles
+
+
+def report(graph, what):
+    cycles = cycles_of(graph)
     for comp in cycles:
         edges = ", ".join(f"{a} -> {b}" for a in comp for b in sorted(graph[a]) if b in comp)
         print("cycle:", edges)
-    print(f"{len(cycles)} cycles among {len(graph)} files")
-    return 1 if cycles else 0
+    print(f"{len(cycles)} cycles among {len(graph)} {what}")
+    return len(cycles)
+
+
+def self_test():
+    """A layered graph passes; one upward call (capture -> attack -> capture) is caught."""
+    layered = {"src/capture/ingest.c": {"src/core/json.c"},
+               "src/attack/stage.c": {"src/capture/ingest.c"}, "src/core/json.c": set()}
+    upward = dict(layered, **{"src/capture/dataset.c": {"src/attack/stage.c"}})
+    clean, found = cycles_of(modules_of(layered)), cycles_of(modules_of(upward))
+    print(f"self-test: layered {clean}, with the upward call {found}")
+    return 0 if not clean and found == [["attack", "capture"]] else 1
+
+
+def modules_of(graph):
+    out = collections.defaultdict(set)
+    for a, targets in graph.items():
+        out.setdefault(module(a), set())
+        for b in targets:
+            if module(a) != module(b):
+                out[module(a)].add(module(b))
+    return dict(out)
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1], sys.argv[2:]))
+    sys.exit(self_test() if sys.argv[1:] == ["--self-test"] else main(sys.argv[1], sys.argv[2:]))

@@ -39,6 +39,8 @@
 #ifndef VF_POSE_H
 #define VF_POSE_H
 
+#include <jansson.h>
+
 #include "vf/error.h"
 
 #ifdef __cplusplus
@@ -158,6 +160,8 @@ void vf_viewpoint_to_c2w(const vf_viewpoint *v, double c2w[16]);
 void vf_c2w_to_viewpoint(const double c2w[16], vf_viewpoint *out);
 
 void vf_viewpoint_to_array(const vf_viewpoint *v, double a[VF_VIEW_DIM]);
+/* [psi, theta, phi, dx, dy, dz] as JSON (a new reference; nan and inf as null). */
+json_t *vf_viewpoint_json(const vf_viewpoint *v);
 vf_viewpoint vf_viewpoint_from_array(const double a[VF_VIEW_DIM]);
 
 #ifdef __cplusplus

@@ -23,6 +23,7 @@
 #include "vf/export.h"
 #include "vf/ingest.h"
 #include "vf/object3d.h"
+#include "vf/real.h"
 #include "vf/poses.h"
 #include "vf/train.h"
 

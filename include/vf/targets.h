@@ -37,8 +37,6 @@ vf_status vf_targets_file_target(const char *path, int n, vf_viewpoint *v);
  * object-frame camera-to-world. VF_EINPUT saying to run export first when there is none. */
 vf_status vf_targets_workspace_target(const char *ws_root, int n, vf_viewpoint *v, double c2w[16]);
 
-/* [psi, theta, phi, dx, dy, dz] (a new reference). */
-json_t *vf_viewpoint_json(const vf_viewpoint *v);
 
 /* Whether viewpoint v lies within +-tolerance (a share, 0.05 for 5%) of each parameter's
  * measurement range (vf_attack_file.range) around `center`; psi differences wrap around 360

@@ -106,6 +106,11 @@ vf_status vf_stage_begin(vf_workspace *ws, const char *stage, vf_stage *s);
 /* Like vf_stage_begin, but keep what an interrupted run left in the staging folder (a stage
  * that checkpoints there continues from it); the folder is created when missing. */
 vf_status vf_stage_resume(vf_workspace *ws, const char *stage, vf_stage *s);
+/* What an interrupted run left in a resumed staging folder (renders, say) is kept only when
+ * it was made for the same request: DIR/request.json is compared with `request` (stolen), and
+ * when it differs the subfolders `subdirs` (NULL-terminated) are removed; then request is
+ * saved. */
+vf_status vf_stage_keep_if_same(const char *dir, json_t *request, const char *const *subdirs);
 /* Swap the staging folder in and record params and summary (both stolen; either may be NULL).
  * On failure nothing is lost: the new output stays in the staging folder (for a retry or a
  * resume) and the stage's previous output and manifest record stay as they were. */

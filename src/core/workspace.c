@@ -562,3 +562,23 @@ void vf_stage_abort(vf_stage *s)
     vf_remove_tree(s->dir);
     release_lock(s);
 }
+
+vf_status vf_stage_keep_if_same(const char *dir, json_t *request, const char *const *subdirs)
+{
+    char path[VF_PATH_MAX], sub[VF_PATH_MAX];
+    json_t *before = NULL;
+    vf_status status = request ? vf_path_join(path, sizeof path, dir, "request.json")
+                               : vf_fail(VF_EINTERNAL, "out of memory");
+    if (status == VF_OK && vf_is_file(path) && vf_json_load(path, &before) == VF_OK &&
+        json_equal(before, request))
+        vf_info("continuing the renders of an interrupted run");
+    else
+        for (int i = 0; status == VF_OK && subdirs[i]; i++)
+            if ((status = vf_path_join(sub, sizeof sub, dir, subdirs[i])) == VF_OK)
+                status = vf_remove_tree(sub);
+    json_decref(before);
+    if (status == VF_OK)
+        status = vf_json_save(path, request);
+    json_decref(request);
+    return status;
+}

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vf/json.h"
 #include "vf/stats.h"
 
 static const double PI = 3.14159265358979323846;
@@ -585,4 +586,11 @@ vf_viewpoint vf_viewpoint_from_array(const double a[VF_VIEW_DIM])
 {
     vf_viewpoint v = {a[0], a[1], a[2], a[3], a[4], a[5]};
     return v;
+}
+
+json_t *vf_viewpoint_json(const vf_viewpoint *v)
+{
+    double a[VF_VIEW_DIM];
+    vf_viewpoint_to_array(v, a);
+    return vf_json_doubles(a, VF_VIEW_DIM);
 }

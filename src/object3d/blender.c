@@ -35,26 +35,6 @@ void vf__blender_view_file(const char *prefix, int i, char *out, size_t size)
     snprintf(out, size, "%s%03d.png", prefix, i);
 }
 
-vf_status vf__keep_renders_for(const char *dir, json_t *request, const char *const *subdirs)
-{
-    char path[VF_PATH_MAX], sub[VF_PATH_MAX];
-    json_t *before = NULL;
-    vf_status status = request ? vf_path_join(path, sizeof path, dir, "request.json")
-                               : vf_fail(VF_EINTERNAL, "out of memory");
-    if (status == VF_OK && vf_is_file(path) && vf_json_load(path, &before) == VF_OK &&
-        json_equal(before, request))
-        vf_info("continuing the renders of an interrupted run");
-    else
-        for (int i = 0; status == VF_OK && subdirs[i]; i++)
-            if ((status = vf_path_join(sub, sizeof sub, dir, subdirs[i])) == VF_OK)
-                status = vf_remove_tree(sub);
-    json_decref(before);
-    if (status == VF_OK)
-        status = vf_json_save(path, request);
-    json_decref(request);
-    return status;
-}
-
 static json_t *job_json(const vf__blender_job *job, const char *info_path)
 {
     json_t *views = json_array();

@@ -123,7 +123,7 @@ static vf_status prepare_folder(const char *model, const vf_object3d_capture *c,
                   vf_json_number(c->camera_angle_x), "min_elevation",
                   vf_json_number(c->min_elevation), "seed", (json_int_t)c->seed, "scene", c->scene);
     static const char *const renders[] = {"images", "test", NULL};
-    return vf__keep_renders_for(out_dir, request, renders);
+    return vf_stage_keep_if_same(out_dir, request, renders);
 }
 
 static json_t *object_json(const char *model, const json_t *fit, const vf_object3d_capture *c,

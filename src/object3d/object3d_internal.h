@@ -33,11 +33,6 @@ typedef struct vf__blender_job {
  * reference). Views whose file exists are not rendered again. */
 vf_status vf__blender_render(const vf__blender_job *job, json_t **fit);
 
-/* Renders left in a staging folder by an interrupted run are kept only when they were made
- * for the same request: DIR/request.json is compared with `request` (stolen), and when it
- * differs the subfolders `subdirs` (NULL-terminated) are removed; then request is saved. */
-vf_status vf__keep_renders_for(const char *dir, json_t *request, const char *const *subdirs);
-
 /* The file name of view i of a job: PREFIX%03d.png. */
 void vf__blender_view_file(const char *prefix, int i, char *out, size_t size);
 

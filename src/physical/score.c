@@ -18,6 +18,7 @@
 #include "vf/object3d.h"
 #include "vf/plot.h"
 #include "vf/pose.h"
+#include "vf/real.h"
 #include "vf/resources.h"
 #include "vf/sharpness.h"
 #include "vf/stats.h"

@@ -48,13 +48,6 @@ vf_status vf_targets_workspace_target(const char *ws_root, int n, vf_viewpoint *
     return status;
 }
 
-json_t *vf_viewpoint_json(const vf_viewpoint *v)
-{
-    return json_pack("[o,o,o,o,o,o]", vf_json_number(v->psi), vf_json_number(v->theta),
-                     vf_json_number(v->phi), vf_json_number(v->dx), vf_json_number(v->dy),
-                     vf_json_number(v->dz));
-}
-
 int vf_viewpoint_within(const vf_viewpoint *v, const vf_viewpoint *center, const double range[6],
                         double tolerance, double *worst)
 {

@@ -7,6 +7,7 @@
 
 #include "vf/json.h"
 #include "vf/log.h"
+#include "vf/real.h"
 
 #define MEMORY_FILE "run.json"
 

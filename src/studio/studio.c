@@ -16,6 +16,7 @@
 #include "vf/json.h"
 #include "vf/log.h"
 #include "vf/object3d.h"
+#include "vf/real.h"
 #include "vf/score.h"
 #include "vf/stats.h"
 #include "vf/targets.h"

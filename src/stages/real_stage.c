@@ -1,4 +1,4 @@
-/* The real check (vf/object3d.h): the attack's viewpoints seen on the object itself.
+/* The real check (vf/real.h): the attack's viewpoints seen on the object itself.
  *
  * Every camera is classified twice, on a render of the field and on Blender's render of the
  * model, with the same classifier camera, normalization and label set, so the two columns
@@ -7,7 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "object3d_internal.h"
 #include "vf/attack_eval.h"
 #include "vf/attack_file.h"
 #include "vf/dataset.h"
@@ -17,6 +16,7 @@
 #include "vf/metrics.h"
 #include "vf/plot.h"
 #include "vf/pose.h"
+#include "vf/real.h"
 #include "vf/resources.h"
 #include "vf/rng.h"
 #include "vf/view_loss.h"
@@ -153,7 +153,7 @@ static vf_status prepare_renders(real_run *r, char *dir, size_t size)
                                 vf_json_number(r->cam.cy), "samples", r->obj.samples, "c2w", poses);
     static const char *const renders[] = {"renders", NULL};
     vf_status s = vf_path_join(dir, size, r->stage.dir, "renders");
-    return s == VF_OK ? vf__keep_renders_for(r->stage.dir, request, renders) : s;
+    return s == VF_OK ? vf_stage_keep_if_same(r->stage.dir, request, renders) : s;
 }
 
 /* How closely the field reproduces the object at each camera. */
