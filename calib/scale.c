@@ -279,24 +279,21 @@ static vf_status measure(const vf_scale_request *r, const vf_workspace *ws, doub
     return status;
 }
 
-vf_status vf_calib_scale_run(const char *ws_root, const vf_scale_request *r, json_t **result)
+vf_status vf_calib_scale_run(vf_workspace *ws, const vf_scale_request *r, json_t **result)
 {
     *result = NULL;
-    vf_workspace ws;
-    vf_status status = vf_workspace_open(ws_root, 0, &ws);
-    if (status != VF_OK)
-        return status;
+    vf_status status;
     double s = 0;
     json_t *details = NULL, *doc = NULL;
     const char *method = r->p1 ? "distance" : "marker";
     vf_stage stage;
     char path[VF_PATH_MAX];
-    status = measure(r, &ws, &s, &details);
+    status = measure(r, ws, &s, &details);
     if (status == VF_OK) {
         doc = json_pack("{s:o, s:o, s:s, s:o}", "metres_per_unit", vf_json_number(s),
                         "units_per_metre", vf_json_number(1.0 / s), "method", method, "details",
                         details);
-        status = vf_stage_begin(&ws, "calib", &stage);
+        status = vf_stage_begin(ws, "calib", &stage);
     } else {
         json_decref(details);
     }
@@ -310,7 +307,6 @@ vf_status vf_calib_scale_run(const char *ws_root, const vf_scale_request *r, jso
         else
             vf_stage_abort(&stage);
     }
-    vf_workspace_close(&ws);
     if (status == VF_OK)
         *result = doc;
     else

@@ -93,8 +93,12 @@ int calib_scale(int argc, char **argv)
     cli_flags flags = {0};
     json_t *result = NULL;
     vf_status status = parse_args(argc, argv, &a, &flags);
+    vf_workspace ws = {0};
     if (status == VF_OK)
-        status = vf_calib_scale_run(a.workspace, &a.req, &result);
+        status = vf_workspace_open(a.workspace, 0, &ws);
+    if (status == VF_OK)
+        status = vf_calib_scale_run(&ws, &a.req, &result);
+    vf_workspace_close(&ws);
     if (status != VF_OK) {
         json_decref(result);
         return cli_fail("calib scale", status);

@@ -91,8 +91,12 @@ static vf_status run(const transfer_options *opt)
                              &model_count);
     for (int m = 0; m < model_count; m++)
         paths[m] = models[m];
+    vf_workspace ws = {0};
     if (s == VF_OK)
-        s = vf_transfer_run(opt->workspace, opt->attack, paths, model_count, &doc);
+        s = vf_workspace_open(opt->workspace, 0, &ws);
+    if (s == VF_OK)
+        s = vf_transfer_run(&ws, opt->attack, paths, model_count, &doc);
+    vf_workspace_close(&ws);
     if (s == VF_OK && opt->flags.json)
         cli_print_json(json_incref(doc));
     else if (s == VF_OK)

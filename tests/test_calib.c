@@ -335,10 +335,10 @@ static void test_scale(void)
     /* the stage stores it where other commands find it */
     vf_scale_request req = {.marker = MARKER_ID, .size_m = 0.1};
     json_t *result = NULL;
-    CHECK(vf_calib_scale_run(root, &req, &result) == VF_OK && result, "calib scale stage: %s",
+    CHECK(vf_workspace_open(root, 0, &ws) == VF_OK, "%s", vf_error_message());
+    CHECK(vf_calib_scale_run(&ws, &req, &result) == VF_OK && result, "calib scale stage: %s",
           vf_error_message());
     json_decref(result);
-    CHECK(vf_workspace_open(root, 0, &ws) == VF_OK, "%s", vf_error_message());
     CHECK(vf_workspace_metres_per_unit(&ws, &s), "scale stored");
     CHECK_NEAR(s, 0.2, 0.002);
     vf_workspace_close(&ws);

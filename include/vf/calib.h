@@ -215,7 +215,7 @@ typedef struct vf_scale_request {
 /* Measure the scale and keep it as the workspace's calib stage (WS/calib/scale.json:
  * metres_per_unit, units_per_metre, method, details); *result (a new reference) is that
  * document. A failed measurement leaves the workspace as it was. */
-vf_status vf_calib_scale_run(const char *ws_root, const vf_scale_request *r, json_t **result);
+vf_status vf_calib_scale_run(vf_workspace *ws, const vf_scale_request *r, json_t **result);
 
 /* Whether the workspace has a metric scale (WS/calib/scale.json); *metres_per_unit gets it. */
 int vf_workspace_metres_per_unit(const vf_workspace *ws, double *metres_per_unit);

@@ -12,15 +12,16 @@
 #include <jansson.h>
 
 #include "vf/error.h"
+#include "vf/workspace.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* Run the stage "transfer/NAME" on the workspace at ws_root (a trained field and the attack
- * NAME, with samples; attack NULL: the only one, vf_attack_choose) for the model files
+/* Run the stage "transfer/NAME" on an open workspace (a trained field and the attack NAME,
+ * with samples; attack NULL: the only one, vf_attack_choose) for the model files
  * models[0..model_count-1]; *result gets transfer.json's document (a new reference). */
-vf_status vf_transfer_run(const char *ws_root, const char *attack, char *const *models,
+vf_status vf_transfer_run(vf_workspace *ws, const char *attack, char *const *models,
                           int model_count, json_t **result);
 
 #ifdef __cplusplus

@@ -61,12 +61,11 @@ static vf_status measure_model(const char *model, const vf_field *field, const d
     return s;
 }
 
-vf_status vf_transfer_run(const char *ws_root, const char *attack, char *const *models,
+vf_status vf_transfer_run(vf_workspace *ws, const char *attack, char *const *models,
                           int model_count, json_t **result)
 {
     char stage_name[160];
     *result = NULL;
-    vf_workspace ws = {0};
     vf_field *field = NULL;
     vf_dataset natural = {0};
     double *c2w = NULL;
@@ -76,18 +75,16 @@ vf_status vf_transfer_run(const char *ws_root, const char *attack, char *const *
     vf_status s = model_count > 0 ? vf_class_names_load()
                                   : vf_fail(VF_EINPUT, "transfer: give at least one model");
     if (s == VF_OK)
-        s = vf_workspace_open(ws_root, 0, &ws);
+        s = vf_field_load_workspace(ws, &field);
     if (s == VF_OK)
-        s = vf_field_load_workspace(&ws, &field);
-    if (s == VF_OK)
-        s = vf_attack_file_load_workspace(&ws, attack, &r);
+        s = vf_attack_file_load_workspace(ws, attack, &r);
     if (s == VF_OK && r.sample_count < 1)
         s = vf_fail(VF_EINPUT, "%s/%s/attack.json has no samples: run the attack again",
-                    ws.root, r.stage);
+                    ws->root, r.stage);
     if (s == VF_OK && snprintf(stage_name, sizeof stage_name, "transfer/%s", r.stage + 7) >=
                           (int)sizeof stage_name)
         s = vf_fail(VF_EINPUT, "attack name too long: %s", r.stage);
-    if (s == VF_OK && (s = vf_dataset_load_training(&ws, &natural, NULL)) == VF_OK &&
+    if (s == VF_OK && (s = vf_dataset_load_training(ws, &natural, NULL)) == VF_OK &&
         !(c2w = vf_dataset_poses(&natural)))
         s = vf_fail(VF_EINTERNAL, "out of memory");
     vf_progress progress;
@@ -103,7 +100,7 @@ vf_status vf_transfer_run(const char *ws_root, const char *attack, char *const *
         vf_progress_end(&progress);
     char path[VF_PATH_MAX];
     json_t *doc = NULL;
-    if (s == VF_OK && (s = vf_stage_begin(&ws, stage_name, &stage)) == VF_OK) {
+    if (s == VF_OK && (s = vf_stage_begin(ws, stage_name, &stage)) == VF_OK) {
         doc = json_pack("{s:s, s:O, s:i, s:O}", "attack_model", r.model, "label", r.label,
                         "samples", r.sample_count, "models", rows);
         s = vf_path_join(path, sizeof path, stage.dir, "transfer.json");
@@ -129,7 +126,6 @@ vf_status vf_transfer_run(const char *ws_root, const char *attack, char *const *
     vf_dataset_free(&natural);
     free(c2w);
     vf_field_free(field);
-    vf_workspace_close(&ws);
     return s;
 }
 

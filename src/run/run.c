@@ -130,7 +130,7 @@ static int stage_is_current(const vf_workspace *ws, const json_t *memory, const 
 
 /* Run the stages in order from the first one that is not current; each stage updates the
  * manifest itself, so the workspace is read again after it. */
-static vf_status run_stages(const char *root, vf_workspace *ws, const vf_run_options *o,
+static vf_status run_stages(vf_workspace *ws, const vf_run_options *o,
                             stage_call *calls, int count, json_t *memory, const char *memory_path)
 {
     int redo = o->restart;
@@ -151,9 +151,8 @@ static vf_status run_stages(const char *root, vf_workspace *ws, const vf_run_opt
         json_t *result = NULL;
         s = call_stage(calls[i].which, ws, o, &result);
         json_decref(result);
-        vf_workspace_close(ws);
-        vf_status reopened = vf_workspace_open(root, 0, ws);
-        if (s == VF_OK && (s = reopened) == VF_OK) {
+        vf_status reloaded = vf_workspace_reload(ws); /* what the stage committed */
+        if (s == VF_OK && (s = reloaded) == VF_OK) {
             vf_info("== %s done in %.0f s ==", calls[i].name, vf_now() - start);
             json_object_set_new(memory, calls[i].name,
                                 json_pack("{s:O, s:s}", "settings", calls[i].settings, "completed",
@@ -194,7 +193,7 @@ vf_status vf_run(const char *ws_root, const vf_run_options *options, json_t **su
         if (!memory)
             memory = json_object();
         double start = vf_now();
-        s = run_stages(ws_root, &ws, &o, calls, count, memory, memory_path);
+        s = run_stages(&ws, &o, calls, count, memory, memory_path);
         if (s == VF_OK) {
             char card[VF_PATH_MAX], report[VF_PATH_MAX];
             vf_workspace_path(&ws, "export", "shot_card.png", card, sizeof card);
