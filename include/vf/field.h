@@ -229,19 +229,7 @@ typedef struct vf_field_train_options {
                                    On noisy photos (Blender's 32-sample renders) the free
                                    harmonics learn each photo's noise as colour that flips with
                                    direction, a speckle the classifier reads; 1e-4 stops it
-                                   (natural accuracy at the training views of four 3D models,
-                                   MobileNetV2, 8000 steps: bell pepper 64 -> 77%, photos 80%;
-                                   vase 56 -> 57%, photos 65%; diffuse colour instead: 82% and
-                                   20%: glass needs its view dependence). On clean photos it
-                                   costs detail: chair at 3 minutes 34.6 dB, 33.6 at 3e-5, 33.0
-                                   at 1e-4; the fox unchanged (23.5 dB). Nor does 1e-4 help
-                                   the real captures with their room (3 minutes, named like
-                                   the photos): the wall clock 54 -> 59%, 59 -> 54%, 57 -> 51%
-                                   (seeds 2, 3, 4), with --appearance 62 -> 65%, 65 -> 70%;
-                                   the fox 40 -> 42%, the shoes 66 -> 62%, the apple 21 -> 16%,
-                                   held-out PSNR within 0.4 dB: noise, so photos keep 0.
-                                   Diffuse colour on the clock (--appearance): 65 -> 59%,
-                                   21.85 -> 20.93 dB: its glass needs the view terms. */
+                                   (3D models keep 1e-4, photos 0; measured in docs/field.md) */
     float opaque;               /* opaque photos: weight of a loss on the transmittance a ray
                                    leaves for the background colour (every pixel sees a surface;
                                    without it a room trains into haze over the background) */

@@ -15,7 +15,7 @@
 #include "vf/normalize.h"
 #include "vf/sfm_export.h"
 
-/* The auto matcher (see choose_methods and the README's "Capturing well"). */
+/* The auto matcher (see choose_methods and docs/capture_and_poses.md). */
 #define EXHAUSTIVE_MAX_FRAMES 40  /* any capture: all pairs are affordable and the surest */
 /* unordered photos: all pairs up to here, then retrieval. Measured by bench_poses (rendered
  * views of the antique camera in the room, 1024 features): at 50 photos all pairs took 133 s and
