@@ -416,7 +416,7 @@ static void check_score_no_frames(const char *ws, char names[][64], int n)
                             vf_test_shared(FOX "/images"), names[0], vf_test_shared(FOX "/images"),
                             names[n / 2], vf_test_shared(FOX "/images"), names[n - 1], dir);
     CHECK(rc == 0, "made the three-photo folder");
-    rc = vf_test_system("'%s' score '%s' '%s' --tolerance 0.01 >/dev/null 2>'%s'", tool(), ws,
+    rc = vf_test_system("'%s' score -q '%s' '%s' --tolerance 0.01 >/dev/null 2>'%s'", tool(), ws,
                         dir, err);
     char *text = NULL;
     CHECK(rc == 1, "no frame in the box exits 1 (%d)", rc);

@@ -74,8 +74,13 @@ static vf_status open_classifier(score_run *run)
     return status;
 }
 
-/* Pass 1: the sharpness every frame must reach, blur_ratio x the median. */
-static vf_status measure_sharpness(score_run *run)
+/* Every frame of the inputs through fn, in order. The inputs are decoded twice, once for the
+ * sharpness (the blur threshold is a share of the median over all frames) and once to score:
+ * decoding again costs less than localizing the blurry frames the threshold then drops. */
+typedef vf_status (*frame_fn)(score_run *run, const vf_rgb8 *frame, const vf_frame_info *info,
+                              void *data);
+
+static vf_status each_frame(score_run *run, frame_fn fn, void *data, vf_progress *progress)
 {
     vf_frames in;
     vf_status status = vf_frames_open(run->inputs, run->input_count, &in);
@@ -83,30 +88,55 @@ static vf_status measure_sharpness(score_run *run)
         return status;
     vf_rgb8 frame = {0};
     vf_frame_info info;
-    double *values = NULL;
-    int n = 0, got;
+    int got, n = 0;
     while ((status = vf_frames_next(&in, &frame, &info, &got)) == VF_OK && got) {
-        vf_frame_score s;
-        double *grown = realloc(values, sizeof *values * (size_t)(n + 1));
-        if (!grown) {
-            status = vf_fail(VF_EINTERNAL, "out of memory");
+        if ((status = fn(run, &frame, &info, data)) != VF_OK) {
+            vf_error_prefix("%s", info.name);
             break;
         }
-        values = grown;
-        if ((status = vf_score_frame(&frame, &s)) != VF_OK)
-            break;
-        values[n++] = s.sharpness;
+        if (progress)
+            vf_progress_update(progress, (size_t)++n, NULL);
     }
     vf_rgb8_free(&frame);
     vf_frames_close(&in);
-    if (status == VF_OK && n == 0)
+    return status;
+}
+
+typedef struct sharpness_list {
+    double *values;
+    int n;
+} sharpness_list;
+
+static vf_status add_sharpness(score_run *run, const vf_rgb8 *frame, const vf_frame_info *info,
+                               void *data)
+{
+    (void)run, (void)info;
+    sharpness_list *list = data;
+    vf_frame_score s;
+    double *grown = realloc(list->values, sizeof *grown * (size_t)(list->n + 1));
+    if (!grown)
+        return vf_fail(VF_EINTERNAL, "out of memory");
+    list->values = grown;
+    vf_status status = vf_score_frame(frame, &s);
+    if (status == VF_OK)
+        list->values[list->n++] = s.sharpness;
+    return status;
+}
+
+/* Pass 1: the sharpness every frame must reach, blur_ratio x the median. */
+static vf_status measure_sharpness(score_run *run)
+{
+    sharpness_list list = {0};
+    vf_status status = each_frame(run, add_sharpness, &list, NULL);
+    if (status == VF_OK && list.n == 0)
         status = vf_fail(VF_EINPUT, "no frames in the given input");
     if (status == VF_OK) {
-        vf_sort_doubles(values, n); /* the median, the upper of the middle two when n is even */
-        run->sharpness_threshold = run->opt->blur_ratio * vf_sorted_quantile(values, n, 0.5);
-        run->frame_count = n;
+        vf_sort_doubles(list.values, list.n); /* the median, the upper middle one when even */
+        run->sharpness_threshold =
+            run->opt->blur_ratio * vf_sorted_quantile(list.values, list.n, 0.5);
+        run->frame_count = list.n;
     }
-    free(values);
+    free(list.values);
     return status;
 }
 
@@ -186,8 +216,10 @@ static void count(tally *t, const vf_attack_file *a, int top)
 }
 
 /* One frame: blur check, localization, box, classification; its row in run->frames. */
-static vf_status score_frame(score_run *run, const vf_rgb8 *frame, const vf_frame_info *info)
+static vf_status score_frame(score_run *run, const vf_rgb8 *frame, const vf_frame_info *info,
+                             void *data)
 {
+    (void)data;
     json_t *row = json_pack("{s:s}", "frame", info->name);
     json_array_append_new(run->frames, row);
     run->total++;
@@ -253,27 +285,13 @@ static vf_status score_frame(score_run *run, const vf_rgb8 *frame, const vf_fram
     return VF_OK;
 }
 
+/* Pass 2: localize, select and classify. */
 static vf_status score_frames(score_run *run)
 {
-    vf_frames in;
-    vf_status status = vf_frames_open(run->inputs, run->input_count, &in);
-    if (status != VF_OK)
-        return status;
-    vf_rgb8 frame = {0};
-    vf_frame_info info;
-    int got;
     vf_progress progress;
     vf_progress_begin(&progress, "scoring", (size_t)run->frame_count, "frames");
-    while ((status = vf_frames_next(&in, &frame, &info, &got)) == VF_OK && got) {
-        if ((status = score_frame(run, &frame, &info)) != VF_OK) {
-            vf_error_prefix("%s", info.name);
-            break;
-        }
-        vf_progress_update(&progress, (size_t)run->total, NULL);
-    }
+    vf_status status = each_frame(run, score_frame, NULL, &progress);
     vf_progress_end(&progress);
-    vf_rgb8_free(&frame);
-    vf_frames_close(&in);
     return status;
 }
 
@@ -416,7 +434,7 @@ vf_status vf_score_run(vf_workspace *ws, char *const *inputs, int input_count,
         status = score_frames(&run);
     if (status == VF_OK && run.kept.frames == 0) /* a failed measurement: nothing committed */
         status = vf_fail(VF_EINPUT,
-                         "no measurement: none of the %d frames is within %.1f%% of %s (%d blurry, "
+                         "no measurement: none of the %d frames is within %g%% of %s (%d blurry, "
                          "%d not localized, %d out of tolerance); re-shoot nearer it ('vfcapture "
                          "reshoot') or widen --tolerance",
                          run.total, 100 * o->tolerance, run.center_name, run.blurry,
