@@ -32,9 +32,13 @@
  * `train --object-only`) cuts every photo by the field's silhouette first: object mode's
  * held-out PSNR, naming and render time, the object on white against the photo cut alike.
  *
+ * --wedge DEG also holds out the photos within DEG / 2 of azimuth of the middle photo and
+ * prints every held-out view's gap to the trained photos (vf/view_coverage.h) beside its
+ * PSNR, with their rank correlation: the calibration of the field's trust on a real capture.
+ *
  * usage: bench_field [SCENE...] [--transforms PATH]... [--minutes 1,2,3,5]
  *                    [--set option=value]... [--model PATH] [--save PATH] [--dump DIR]
- *                    [--holdout N] [--cut] */
+ *                    [--holdout N] [--wedge DEG] [--cut] */
 #define _GNU_SOURCE
 #include <math.h>
 #include <omp.h>
@@ -55,6 +59,7 @@
 #include "vf/resources.h"
 #include "vf/rng.h"
 #include "vf/stats.h"
+#include "vf/view_coverage.h"
 #include "vf/viewfool.h"
 
 typedef struct view_set {
@@ -89,11 +94,21 @@ static void die(const char *what)
 /* Held-out frames: every 8th from the first for a model trained here; with --holdout N, a
  * workspace's model is scored on the frames its train stage held out (frame % N == N / 2). */
 static int stage_holdout;
+/* --wedge DEG: also hold out every frame whose camera's azimuth (object frame, z up) lies
+ * within DEG / 2 of the middle frame's, so held-out views lie far from the trained ones. */
+static double wedge_deg;
 
-static int is_held(int frame, int holdout_every)
+static int is_held(const vf_dataset *ds, int frame, int holdout_every)
 {
     if (holdout_every <= 0)
         return 0;
+    if (wedge_deg > 0) {
+        const double *c = ds->frames[frame].c2w, *m = ds->frames[ds->count / 2].c2w;
+        double turn = (atan2(c[7], c[3]) - atan2(m[7], m[3])) * 180 / M_PI;
+        turn = fabs(remainder(turn, 360.0));
+        if (turn <= 0.5 * wedge_deg)
+            return 1;
+    }
     return stage_holdout ? frame % stage_holdout == stage_holdout / 2
                          : frame % holdout_every == 0;
 }
@@ -153,7 +168,7 @@ static void load_views(const char *name, int holdout_every, view_set *train, vie
     }
     int failed = 0;
     for (int i = 0; i < ds.count; i++) {
-        int to_held = is_held(i, holdout_every);
+        int to_held = is_held(&ds, i, holdout_every);
         view_set *s = to_held ? held : train;
         if (!s)
             continue;
@@ -173,7 +188,7 @@ static void load_views(const char *name, int holdout_every, view_set *train, vie
     int *slot = malloc(sizeof(int) * (size_t)ds.count);
     view_set **owner = malloc(sizeof(view_set *) * (size_t)ds.count);
     for (int i = 0; i < ds.count; i++) {
-        int to_held = is_held(i, holdout_every);
+        int to_held = is_held(&ds, i, holdout_every);
         owner[i] = to_held ? held : train;
         slot[i] = to_held ? hi++ : ti++;
     }
@@ -352,11 +367,16 @@ static double psnr_colour_matched(const vf_image *render, const vf_image *truth)
     return -10 * log10(fmax(sse / (3.0 * n), 1e-20));
 }
 
+/* With --wedge, evaluate() prints each held-out view's gap to these trained views. */
+static const view_set *gap_from;
+
 static void evaluate(const char *name, const vf_field *f, const view_set *test, const float bg[3],
                      run_result *r)
 {
     double psnr = 0, ssim = 0, object = 0, matched = 0, t0 = vf_now();
     int masked = 0;
+    double *gap = calloc((size_t)test->count + 1, 2 * sizeof(double)),
+           *view_psnr = gap + test->count;
     for (int i = 0; i < test->count; i++) {
         vf_image render = {0}, truth = {0};
         if (vf_field_render(f, &test->cameras[i], test->c2w + 16 * i, &render) != VF_OK)
@@ -373,9 +393,20 @@ static void evaluate(const char *name, const vf_field *f, const view_set *test, 
         ssim += vf_image_ssim(&render, &truth);
         if (dump_dir)
             dump_pair(name, i, &truth, &render, p);
+        if (gap_from) {
+            gap[i] =
+                vf_view_trust_of_pose(gap_from->c2w, gap_from->count, test->c2w + 16 * i).gap_deg;
+            view_psnr[i] = p;
+            printf("%-6s held-out view %2d: gap to the trained photos %5.1f deg, PSNR %.2f dB\n",
+                   name, i, gap[i], p);
+        }
         vf_image_free(&render);
         vf_image_free(&truth);
     }
+    if (gap_from)
+        printf("%-6s Spearman(gap, PSNR) over the %d held-out views: %.3f\n", name, test->count,
+               vf_spearman(gap, view_psnr, test->count));
+    free(gap);
     r->psnr = psnr / test->count;
     r->psnr_matched = matched / test->count;
     r->ssim = ssim / test->count;
@@ -610,6 +641,8 @@ int main(int argc, char **argv)
             dump_dir = argv[++i];
         } else if (!strcmp(argv[i], "--holdout") && i + 1 < argc) {
             stage_holdout = atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--wedge") && i + 1 < argc) {
+            wedge_deg = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--cut")) {
             cut = 1;
         } else if (!strcmp(argv[i], "--save") && i + 1 < argc) {
@@ -628,7 +661,7 @@ int main(int argc, char **argv)
             fprintf(stderr,
                     "usage: bench_field [chair] [lego] [fox] [render] [--transforms PATH]... "
                     "[--minutes 1,2,3,5] [--set option=value]... [--model PATH] "
-                    "[--save PATH] [--dump DIR] [--holdout N] [--cut]\n");
+                    "[--save PATH] [--dump DIR] [--holdout N] [--wedge DEG] [--cut]\n");
             return 1;
         }
     }
@@ -718,7 +751,9 @@ int main(int argc, char **argv)
                 f = train(&opt, &train_views, &r);
             if (cut)
                 cut_views(f, &held);
+            gap_from = wedge_deg > 0 ? &train_views : NULL;
             evaluate(name, f, &held, white, &r);
+            gap_from = NULL;
             print_run(name, r.train_seconds / 60, &r, !strcmp(name, "fox") ? 25 : 0);
             load_views(captures[c], 0, &all, NULL);
             if (cut)

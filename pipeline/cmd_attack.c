@@ -15,7 +15,7 @@ static const char usage[] =
     "                       [--method nes|pepg|random] [--lambda X] [--samples K] [--steps N] "
     "[--components K]\n"
     "                       [--space rotation|translation|both] [--bounds name=lo:hi,...]\n"
-    "                       [--seed S] [--attack NAME] [--restart] [--json]\n"
+    "                       [--trust-gap DEG] [--seed S] [--attack NAME] [--restart] [--json]\n"
     "\n"
     "Find the viewpoints from which the classifier misreads the object (ViewFool, Dong et al.,\n"
     "NeurIPS 2022): learn a distribution p(v) over viewpoints v = (psi, theta, phi in degrees,\n"
@@ -46,6 +46,11 @@ static const char usage[] =
     "                         theta, phi, dx, dy, dz). Default: psi -180:180, theta -30:30,\n"
     "                         phi 20:160, dx -0.5:0.5, dy -1:1, dz -0.5:0.5; for a real capture\n"
     "                         (poses stage) the range its photos cover\n"
+    "      --trust-gap DEG    search only where the field can be trusted: a viewpoint more\n"
+    "                         than DEG from every photo (angle seen from the object, distance\n"
+    "                         ratio counted as an angle) is not rendered, never counts as\n"
+    "                         fooled and pushes the search back (default 20; 0 switches it\n"
+    "                         off). attack.json's \"trust\" gives v*'s gap\n"
     "      --seed S           random seed (default 0): the same seed gives the same result\n"
     "      --attack NAME      the attack's name (default: model-method-lLAMBDA-space); the\n"
     "                         same name again replaces that attack\n"
@@ -64,6 +69,7 @@ enum {
     OPT_RESTART,
     OPT_SAMPLES,
     OPT_STEPS,
+    OPT_TRUST_GAP,
 };
 
 typedef struct attack_cli {
@@ -90,6 +96,7 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
         {"bounds", required_argument, NULL, OPT_BOUNDS},
         {"seed", required_argument, NULL, OPT_SEED},
         {"restart", no_argument, NULL, OPT_RESTART},
+        {"trust-gap", required_argument, NULL, OPT_TRUST_GAP},
         {0, 0, 0, 0},
     };
     vf_attack_options *o = &cli->attack;
@@ -124,6 +131,7 @@ static vf_status parse_options(int argc, char **argv, attack_cli *cli)
         case OPT_BOUNDS: o->bounds = optarg; break;
         case OPT_SEED: s = cli_seed("--seed", optarg, &o->seed); break;
         case OPT_RESTART: o->restart = 1; break;
+        case OPT_TRUST_GAP: s = cli_number("--trust-gap", optarg, 0, 180, &o->trust_gap); break;
         case CLI_OPT_ATTACK: o->name = optarg; break;
         default: break;
         }
@@ -186,6 +194,13 @@ static void print_summary(const attack_cli *cli, const json_t *doc)
     const json_t *baseline = json_object_get(doc, "random_search");
     if (baseline)
         printf("   (random search: %.0f%%)", 100 * number(baseline, "asr_samples"));
+    const json_t *trust = json_object_get(doc, "trust");
+    if (json_is_number(json_object_get(trust, "gap_limit_deg")))
+        printf("\ntrust: v* %.1f deg from the nearest photo (%s the %.0f deg limit); %.0f%% of "
+               "the samples within it",
+               number(trust, "v_star_gap_deg"),
+               json_is_true(json_object_get(trust, "v_star_trusted")) ? "within" : "BEYOND",
+               number(trust, "gap_limit_deg"), 100 * number(trust, "samples_trusted"));
     print_six("\nstd of the samples: psi %.2f, theta %.2f, phi %.2f, dx %.3f, dy %.3f, dz %.3f\n",
               json_object_get(doc, "sample_std"));
     printf("ASR under fluctuation r = 1..10%%:");

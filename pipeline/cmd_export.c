@@ -74,14 +74,19 @@ static void print_targets(const char *ws, const json_t *doc)
         const json_t *w = json_object_get(t, "words");
         const char *predicted =
             json_string_value(json_object_get(json_object_get(t, "prediction"), "name"));
-        char d[32], h[32];
+        const json_t *trust = json_object_get(t, "trust");
+        char d[32], h[32], gap[64] = "";
         distance_text(w, "distance", d, sizeof d);
         distance_text(w, "height", h, sizeof h);
+        if (trust)
+            snprintf(gap, sizeof gap, "; %.0f deg from the nearest photo%s",
+                     number(trust, "gap_deg"),
+                     json_is_true(json_object_get(trust, "trusted")) ? "" : " (BEYOND the limit)");
         printf("target %zu (%s): azimuth %.0f deg, elevation %.0f deg, distance %s, height %s, "
-               "roll %.0f deg%s%s\n",
+               "roll %.0f deg%s%s%s\n",
                i, json_string_value(json_object_get(t, "kind")), number(w, "azimuth_deg"),
                number(w, "elevation_deg"), d, h, number(w, "roll_deg"),
-               predicted ? "; predicted " : "", predicted ? predicted : "");
+               predicted ? "; predicted " : "", predicted ? predicted : "", gap);
     }
     printf("targets in %s/export/ (targets.json, targets.csv, shot_card.png)\n", ws);
 }

@@ -464,6 +464,14 @@ static void check_export(const char *ws)
     vf_colmap_model_free(&model);
     CHECK(worst >= 0 && worst < 1e-6, "v* in COLMAP's frame is the frame's COLMAP pose (off by %g)",
           worst);
+    /* v* is that frame's pose: no gap to the photos, the frame its nearest photo */
+    const json_t *trust = json_object_get(json_array_get(targets, 0), "trust");
+    const char *nearest = json_string_value(json_object_get(trust, "nearest_photo"));
+    CHECK(json_number_value(json_object_get(trust, "gap_deg")) < 1e-3 &&
+              json_is_true(json_object_get(trust, "trusted")) && nearest &&
+              strstr(nearest, V_STAR_FRAME),
+          "v*'s trust: %.3g deg from %s", json_number_value(json_object_get(trust, "gap_deg")),
+          nearest ? nearest : "?");
     json_t *words = json_object_get(json_array_get(targets, 0), "words");
     printf("v* in words: azimuth %.1f deg, elevation %.1f deg, distance %.2f, roll %.1f deg\n",
            json_number_value(json_object_get(words, "azimuth_deg")),

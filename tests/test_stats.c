@@ -34,10 +34,26 @@ static void test_quantile(void)
     CHECK(with_nan[0] == 1 && with_nan[2] == 3 && isnan(with_nan[3]), "NaN sorts last");
 }
 
+/* Rank correlation: any increasing map is 1, a reversed one -1, ties take their mean rank
+ * (sqrt(0.95) for this pair), a constant has none. */
+static void test_spearman(void)
+{
+    double x[] = {1, 2, 3, 4, 5}, y[] = {2, 20, 21, 300, 1000}, down[] = {5, 4, 3, 2, 1};
+    CHECK_NEAR(vf_spearman(x, y, 5), 1.0, 1e-12);
+    CHECK_NEAR(vf_spearman(x, down, 5), -1.0, 1e-12);
+    double tied[] = {1, 2, 2, 3, 5};
+    double r_tied = vf_spearman(x, tied, 5);
+    /* ranks 0, 1.5, 1.5, 3, 4 against 0..4: products 9.5 over sqrt(10 * 9.5) */
+    CHECK_NEAR(r_tied, 9.5 / sqrt(10 * 9.5), 1e-12);
+    double flat[] = {7, 7, 7, 7, 7};
+    CHECK(isnan(vf_spearman(x, flat, 5)) && isnan(vf_spearman(x, y, 2)), "no order, no value");
+}
+
 int main(int argc, char **argv)
 {
     check_args(argc, argv);
     CHECK_CASE(test_median);
     CHECK_CASE(test_quantile);
+    CHECK_CASE(test_spearman);
     return check_finish();
 }

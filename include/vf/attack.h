@@ -10,7 +10,11 @@
  * (WS/train/model.vff) and the training cameras; classify renders at the training poses
  * (natural accuracy, and the label set by majority vote when none is given); choose the
  * search box (a real capture, one the poses stage posed: the range its photos cover,
- * vf/view_coverage.h; then --space, then the caller's bounds); optimize p(v) (vf/viewfool.h)
+ * vf/view_coverage.h; then --space, then the caller's bounds); keep the search to the
+ * viewpoints the field can vouch for, those within o.trust_gap degrees of a photo
+ * (vf_view_loss_set_trust: a penalty beyond, so p*(v) is pushed back; attack.json's "trust"
+ * gives v*'s gap and the share of the samples inside, and a v* outside is a warning);
+ * optimize p(v) (vf/viewfool.h)
  * with a checkpoint a step in the staging folder; measure v*, VF_EVAL_SAMPLES samples,
  * fluctuation and the random-search baseline (vf/attack_eval.h); write attack.json
  * (vf/attack_file.h), v_star.png, samples.png, loss.png and fluctuation.png; commit.
@@ -64,6 +68,9 @@ typedef struct vf_attack_options {
     uint64_t seed;           /* 0: the same seed gives the same result */
     int restart;             /* discard an interrupted attack's checkpoint (see the top) */
     const char *name;        /* the attack's name; NULL: vf_attack_default_name */
+    double trust_gap;        /* degrees: viewpoints farther from the photos are not rendered,
+                                never fooled, and pushed back (vf_view_loss_set_trust);
+                                VF_TRUST_GAP_DEG, 0 switches it off */
 } vf_attack_options;
 
 void vf_attack_defaults(vf_attack_options *o);

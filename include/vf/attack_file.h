@@ -63,6 +63,7 @@ typedef struct vf_attack_outcome {
     const vf_random_search_result *baseline; /* NULL for random search */
     double seconds_natural, seconds_attack, seconds_eval, seconds_baseline;
     vf_view_loss_stats stats;
+    double trust_gap; /* the trust limit in degrees (0: off; vf_view_loss_set_trust) */
 } vf_attack_outcome;
 
 /* attack.json's document (a new reference). */
@@ -94,6 +95,7 @@ typedef struct vf_attack_file {
     vf_sample_prediction *predictions;      /* sample_count entries, or NULL when absent */
     vf_sample_prediction v_star_prediction; /* cls -1 when attack.json does not say */
     double natural_accuracy, asr_v_star, asr_samples; /* NAN when absent */
+    double trust_gap; /* the attack's trust limit in degrees ("trust"); 0 when off or absent */
     int has_camera;
     vf_camera camera; /* the render camera */
     /* p*(v): components 0 for random search (or a file without "mu"/"sigma") */

@@ -40,7 +40,9 @@ typedef struct vf_view_prediction {
     int top_class;    /* top-1 ImageNet class */
     float top_prob;   /* its probability */
     float label_prob; /* total probability of the label set, exp(-loss) (0 before labels are set) */
-    int correct;      /* top_class is in the label set */
+    int correct;      /* top_class is in the label set (an untrusted view: 1, see below) */
+    double gap_deg;   /* the view's gap to the photos (vf/view_coverage.h); NAN: no trust set */
+    int untrusted;    /* the gap is over the trust limit: not rendered, never fooled */
 } vf_view_prediction;
 
 /* Time spent so far, for reports and benchmarks. */
@@ -75,6 +77,16 @@ vf_status vf_view_loss_classify_poses(vf_view_loss *vl, const double *c2w, int n
  * of the field. VF_EINPUT when an image has another size. */
 vf_status vf_view_loss_classify_images(vf_view_loss *vl, const vf_image *images, int n,
                                        vf_view_prediction *out);
+
+/* Viewpoints the field can vouch for (vf/view_coverage.h): from now on a viewpoint of
+ * vf_view_loss_classify whose gap to the `count` photo cameras (count x 16, borrowed, must
+ * outlive vl) exceeds limit_deg is not rendered: its prediction is "untrusted", correct (never
+ * counted as fooled), top_class -1, and its loss is -(gap - limit) / limit, below every
+ * rendered view's (cross-entropies are >= 0) and lower the farther out, so the search is
+ * pushed back towards the photos instead of finding its viewpoints in fog. limit_deg <= 0
+ * switches the limit off (every view rendered, its gap still given). Camera poses
+ * (vf_view_loss_classify_poses) are always rendered. */
+void vf_view_loss_set_trust(vf_view_loss *vl, const double *photos, int count, double limit_deg);
 
 /* The attack's loss callback (vf/viewfool.h, vf_attack_loss_fn); ctx is a vf_view_loss with
  * its labels set. */

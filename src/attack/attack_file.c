@@ -104,9 +104,24 @@ static void add_distribution(json_t *doc, const vf_attack_state *st, const vf_at
     json_decref(sigma);
 }
 
+/* "trust": the limit, v*'s gap to the photos and the share of the samples within it. */
+static json_t *trust_json(const vf_attack_outcome *o)
+{
+    const vf_attack_eval *ev = o->ev;
+    int inside = 0;
+    for (int i = 0; i < ev->sample_count; i++)
+        inside += !ev->sample_pred[i].untrusted;
+    return json_pack("{s:o, s:o, s:b, s:o}", "gap_limit_deg",
+                     o->trust_gap > 0 ? vf_json_number(o->trust_gap) : json_null(),
+                     "v_star_gap_deg", vf_json_number(ev->v_star_pred.gap_deg), "v_star_trusted",
+                     !ev->v_star_pred.untrusted, "samples_trusted",
+                     vf_json_number(ev->sample_count ? (double)inside / ev->sample_count : NAN));
+}
+
 json_t *vf_attack_file_json(const vf_attack_outcome *o)
 {
     json_t *doc = eval_json(o->ev);
+    json_object_set_new(doc, "trust", trust_json(o));
     const vf_camera *cam = &o->camera;
     double views = o->stats.views ? (double)o->stats.views : 1.0;
     json_object_set_new(doc, "model", json_string(o->model));
@@ -320,6 +335,8 @@ vf_status vf_attack_file_load(const char *path, vf_attack_file *out)
         out->natural_accuracy = number_or_nan(doc, "natural_accuracy");
         out->asr_v_star = number_or_nan(doc, "asr_v_star");
         out->asr_samples = number_or_nan(doc, "asr_samples");
+        double limit = number_or_nan(json_object_get(doc, "trust"), "gap_limit_deg");
+        out->trust_gap = limit > 0 && limit <= 180 ? limit : 0;
         status = read_camera(doc, path, out);
     }
     json_decref(doc);

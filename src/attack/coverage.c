@@ -1,4 +1,4 @@
-/* The viewpoint box a capture covers (vf/view_coverage.h). */
+/* The viewpoint box a capture covers and a viewpoint's gap to its photos (vf/view_coverage.h). */
 #include "vf/view_coverage.h"
 
 #include <math.h>
@@ -72,3 +72,44 @@ vf_status vf_view_coverage(const double *c2w, int count, vf_view_bounds *out)
     out->hi[1] = fmin(out->hi[1], 89.0);
     return VF_OK;
 }
+
+/* A camera's centre: its distance from the object and the unit direction to it. */
+static double centre_direction(const double c2w[16], double dir[3])
+{
+    double r = sqrt(c2w[3] * c2w[3] + c2w[7] * c2w[7] + c2w[11] * c2w[11]);
+    for (int k = 0; k < 3; k++)
+        dir[k] = r > 0 ? c2w[4 * k + 3] / r : 0;
+    return r;
+}
+
+vf_view_trust vf_view_trust_of_pose(const double *photos, int count, const double c2w[16])
+{
+    double dir[3], best = INFINITY;
+    double r = centre_direction(c2w, dir);
+    vf_view_trust t = {.gap_deg = INFINITY, .nearest = -1};
+    for (int i = 0; i < count; i++) {
+        double d[3];
+        double ri = centre_direction(photos + 16 * (size_t)i, d);
+        double cosine = fmax(-1.0, fmin(1.0, dir[0] * d[0] + dir[1] * d[1] + dir[2] * d[2]));
+        double angle = acos(cosine), scale = log(fmax(r, 1e-9) / fmax(ri, 1e-9));
+        double gap = angle * angle + scale * scale;
+        if (gap < best) {
+            best = gap;
+            t = (vf_view_trust){.gap_deg = sqrt(gap) * 180 / M_PI,
+                                .nearest = i,
+                                .angle_deg = angle * 180 / M_PI,
+                                .distance_ratio = ri > 0 ? r / ri : INFINITY};
+        }
+    }
+    return t;
+}
+
+vf_view_trust vf_view_trust_of(const double *photos, int count, const double view[VF_VIEW_DIM])
+{
+    vf_viewpoint v = vf_viewpoint_from_array(view);
+    double c2w[16];
+    vf_viewpoint_to_c2w(&v, c2w);
+    return vf_view_trust_of_pose(photos, count, c2w);
+}
+
+int vf_view_trusted(const vf_view_trust *t) { return t->gap_deg <= VF_TRUST_GAP_DEG; }

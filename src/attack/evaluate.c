@@ -2,6 +2,7 @@
  * (vf/attack_eval.h). */
 #include "vf/attack_eval.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "vf/classifier.h"
@@ -100,8 +101,14 @@ vf_status vf_attack_eval_random(vf_view_loss *vl, const vf_view_bounds *bounds, 
 
 json_t *vf_view_prediction_to_json(const vf_view_prediction *p)
 {
-    return json_pack("{s:i, s:s, s:o, s:o, s:b}", "class", p->top_class, "name",
-                     vf_class_short_name(p->top_class), "confidence",
-                     vf_json_number((double)p->top_prob), "label_probability",
-                     vf_json_number((double)p->label_prob), "fooled", !p->correct);
+    json_t *doc =
+        json_pack("{s:i, s:s, s:o, s:o, s:b}", "class", p->top_class, "name",
+                  p->untrusted ? "(untrusted: not rendered)" : vf_class_short_name(p->top_class),
+                  "confidence", vf_json_number((double)p->top_prob), "label_probability",
+                  vf_json_number((double)p->label_prob), "fooled", !p->correct);
+    if (doc && !isnan(p->gap_deg)) {
+        json_object_set_new(doc, "gap_deg", vf_json_number(p->gap_deg));
+        json_object_set_new(doc, "trusted", json_boolean(!p->untrusted));
+    }
+    return doc;
 }

@@ -46,7 +46,8 @@ void vf_attack_defaults(vf_attack_options *o)
                              .lambda = -1,
                              .steps = 100,
                              .components = 1,
-                             .space = VF_SPACE_BOTH};
+                             .space = VF_SPACE_BOTH,
+                             .trust_gap = VF_TRUST_GAP_DEG};
 }
 
 void vf_attack_default_name(const vf_attack_options *o, char *out, size_t size)
@@ -77,6 +78,8 @@ vf_status vf_attack_options_check(const vf_attack_options *o)
                        VF_ATTACK_MAX_COMPONENTS, o->components);
     if (o->components > 1 && o->method != VF_SEARCH_NES)
         return vf_fail(VF_EINPUT, "a mixture of components needs the nes method");
+    if (!(o->trust_gap >= 0 && o->trust_gap <= 180))
+        return vf_fail(VF_EINPUT, "the trust gap is 0 (off) to 180 degrees, not %g", o->trust_gap);
     char stage[160];
     snprintf(stage, sizeof stage, "attack/%s", o->name ? o->name : "x");
     if (o->name && vf_stage_name_check(stage) != VF_OK)
@@ -275,9 +278,9 @@ static json_t *setup_json(const attack_run *run)
     json_t *labels = json_array();
     for (int i = 0; i < run->label_count; i++)
         json_array_append_new(labels, json_integer(run->labels[i]));
-    return json_pack("{s:s, s:o, s:o, s:o}", "model", run->model_path, "labels", labels,
-                     "config", vf_attack_config_to_json(&run->cfg), "field",
-                     field_identity(run));
+    return json_pack("{s:s, s:o, s:o, s:o, s:o}", "model", run->model_path, "labels", labels,
+                     "trust_gap", vf_json_number(run->opt->trust_gap), "config",
+                     vf_attack_config_to_json(&run->cfg), "field", field_identity(run));
 }
 
 static vf_status save_checkpoint(const attack_run *run, const vf_attack_state *st)
@@ -379,7 +382,8 @@ static json_t *result_json(const attack_run *run, const vf_attack_state *st,
                            .seconds_attack = run->seconds_attack,
                            .seconds_eval = run->seconds_eval,
                            .seconds_baseline = run->seconds_baseline,
-                           .stats = vf_view_loss_get_stats(run->vl)};
+                           .stats = vf_view_loss_get_stats(run->vl),
+                           .trust_gap = run->opt->trust_gap};
     return vf_attack_file_json(&o);
 }
 
@@ -403,6 +407,11 @@ static vf_status attack_and_report(attack_run *run, json_t **result)
                    : vf_attack_eval_distribution(run->vl, &st, &run->cfg, run->cfg.seed, ev);
     }
     run->seconds_eval = vf_now() - t0;
+    if (s == VF_OK && ev->v_star_pred.untrusted)
+        vf_warn("v* lies %.0f degrees from the nearest photo, beyond the %.0f the field can "
+                "vouch for: it is not counted as adversarial; film more views around the object "
+                "or widen --trust-gap",
+                ev->v_star_pred.gap_deg, run->opt->trust_gap);
     t0 = vf_now();
     if (s == VF_OK && !random) {
         vf_info("random-search baseline (%d uniform viewpoints)...", VF_EVAL_SAMPLES);
@@ -476,8 +485,10 @@ vf_status vf_attack_run(vf_workspace *ws, const vf_attack_options *o, json_t **r
     }
     if (s == VF_OK)
         s = natural_views(&run);
-    if (s == VF_OK)
+    if (s == VF_OK) {
+        vf_view_loss_set_trust(run.vl, run.c2w, run.view_count, o->trust_gap);
         s = restrict_space(&run);
+    }
     if (s == VF_OK)
         s = attack_and_report(&run, result);
     /* A failure after the stage began leaves its staging folder (and checkpoint) for the

@@ -7,6 +7,7 @@
 
 #include "vf/log.h"
 #include "vf/pose.h"
+#include "vf/view_coverage.h"
 
 struct vf_view_loss {
     const vf_field *field;
@@ -19,6 +20,9 @@ struct vf_view_loss {
     float *logits;                        /* chunk x 1000 */
     double losses[VF_VIEW_LOSS_CHUNK];    /* the chunk's label-set cross-entropies */
     vf_view_loss_stats stats;
+    const double *photos; /* the trust's photo cameras (NULL: every view is rendered) */
+    int photo_count;
+    double trust_limit;
 };
 
 vf_status vf_view_loss_create(const vf_field *field, vf_classifier *cls, vf_view_loss **out)
@@ -79,6 +83,8 @@ static void predict(const vf_view_loss *vl, float *logits, vf_view_prediction *o
     out->top_class = top;
     out->correct = vf_label_set_contains(vl->labels, vl->label_count, top);
     out->label_prob = (float)exp(-*loss);
+    out->gap_deg = NAN;
+    out->untrusted = 0;
 }
 
 /* Classify n (<= chunk) images of the model's input size. */
@@ -122,23 +128,58 @@ vf_status vf_view_loss_classify_images(vf_view_loss *vl, const vf_image *images,
     return VF_OK;
 }
 
+void vf_view_loss_set_trust(vf_view_loss *vl, const double *photos, int count, double limit_deg)
+{
+    int on = photos && count > 0;
+    vl->photos = on ? photos : NULL;
+    vl->photo_count = on ? count : 0;
+    vl->trust_limit = limit_deg > 0 ? limit_deg : INFINITY;
+}
+
+/* An untrusted view's prediction and loss (vf_view_loss_set_trust). */
+static double untrusted(const vf_view_loss *vl, double gap, vf_view_prediction *out)
+{
+    *out = (vf_view_prediction){.top_class = -1, .correct = 1, .gap_deg = gap, .untrusted = 1};
+    return -(gap - vl->trust_limit) / vl->trust_limit;
+}
+
 vf_status vf_view_loss_classify(vf_view_loss *vl, const double *views, int n,
                                 vf_view_prediction *out, double *losses)
 {
-    for (int first = 0; first < n; first += VF_VIEW_LOSS_CHUNK) {
-        int m = n - first < VF_VIEW_LOSS_CHUNK ? n - first : VF_VIEW_LOSS_CHUNK;
+    for (int first = 0; first < n;) {
+        /* the next chunk of views to render; untrusted ones are answered on the way */
         vf_viewpoint vp[VF_VIEW_LOSS_CHUNK];
-        for (int i = 0; i < m; i++)
-            vp[i] = vf_viewpoint_from_array(views + 6 * (size_t)(first + i));
+        int index[VF_VIEW_LOSS_CHUNK], m = 0;
+        double gap[VF_VIEW_LOSS_CHUNK];
+        for (; first < n && m < VF_VIEW_LOSS_CHUNK; first++) {
+            const double *v = views + 6 * (size_t)first;
+            double g = vl->photos ? vf_view_trust_of(vl->photos, vl->photo_count, v).gap_deg : NAN;
+            if (g > vl->trust_limit) { /* NAN (no photos) compares false */
+                double loss = untrusted(vl, g, &out[first]);
+                if (losses)
+                    losses[first] = loss;
+                continue;
+            }
+            gap[m] = g;
+            index[m] = first;
+            vp[m++] = vf_viewpoint_from_array(v);
+        }
+        if (!m)
+            continue;
+        vf_view_prediction pred[VF_VIEW_LOSS_CHUNK];
         double t0 = vf_now();
         vf_status status = vf_field_render_viewpoints(vl->field, &vl->camera, vp, m, vl->images);
         vl->stats.render_seconds += vf_now() - t0;
         if (status == VF_OK)
-            status = classify_chunk(vl, vl->images, m, out + first);
+            status = classify_chunk(vl, vl->images, m, pred);
         if (status != VF_OK)
             return status;
-        for (int i = 0; losses && i < m; i++)
-            losses[first + i] = vl->losses[i];
+        for (int i = 0; i < m; i++) {
+            out[index[i]] = pred[i];
+            out[index[i]].gap_deg = gap[i];
+            if (losses)
+                losses[index[i]] = vl->losses[i];
+        }
     }
     return VF_OK;
 }

@@ -10,15 +10,16 @@
 #include "shot_card.h"
 #include "vf/attack_file.h"
 #include "vf/calib.h"
-#include "vf/csv.h"
 #include "vf/classifier.h"
 #include "vf/csv.h"
+#include "vf/dataset.h"
 #include "vf/field.h"
 #include "vf/json.h"
 #include "vf/localize.h"
 #include "vf/log.h"
 #include "vf/resources.h"
 #include "vf/targets.h"
+#include "vf/view_coverage.h"
 
 #define PREVIEW_SIZE 224
 
@@ -29,7 +30,8 @@ typedef struct target {
     double c2w[16], c2w_colmap[16];
     vf_target_words words;
     vf_sample_prediction pred;
-    vf_image preview;
+    vf_view_trust trust;     /* gap to the nearest training photo (gap_deg NAN: no photos) */
+    vf_image preview, photo; /* the field's render there; the nearest photo, scaled */
 } target;
 
 typedef struct export_run {
@@ -41,6 +43,9 @@ typedef struct export_run {
     double metres;  /* metres per scene unit, 0 when unknown */
     vf_field *field;
     vf_classifier *cls;
+    vf_dataset photos; /* the field's training frames (count 0 when unreadable) */
+    double *photo_c2w;
+    double trust_limit; /* degrees: the attack's limit, or VF_TRUST_GAP_DEG */
     target *targets;
     int target_count;
 } export_run;
@@ -63,6 +68,14 @@ static vf_status load_inputs(export_run *run, const vf_workspace *ws, const char
         status = vf_field_load_workspace(ws, &run->field);
     else
         vf_warn("no trained field (WS/train/model.vff): the shot card has no previews");
+    run->trust_limit = run->attack.trust_gap > 0 ? run->attack.trust_gap : VF_TRUST_GAP_DEG;
+    if (status == VF_OK && vf_dataset_load_training(ws, &run->photos, NULL) != VF_OK) {
+        vf_warn("the training photos cannot be read: targets without their trust");
+        memset(&run->photos, 0, sizeof run->photos);
+    }
+    if (status == VF_OK && run->photos.count > 0 &&
+        !(run->photo_c2w = vf_dataset_poses(&run->photos)))
+        status = vf_fail(VF_EINTERNAL, "out of memory");
     return status;
 }
 
@@ -106,8 +119,33 @@ static vf_status choose_targets(export_run *run)
         if (run->has_colmap)
             vf_similarity_apply_c2w(&run->colmap_from_object, t->c2w, t->c2w_colmap);
         vf_target_describe(t->c2w, &t->words);
+        t->trust = run->photo_c2w ? vf_view_trust_of_pose(run->photo_c2w, run->photos.count, t->c2w)
+                                  : (vf_view_trust){.gap_deg = NAN, .nearest = -1};
     }
     return VF_OK;
+}
+
+static int trusted(const export_run *run, const target *t)
+{
+    return t->trust.gap_deg <= run->trust_limit;
+}
+
+/* The nearest training photo, scaled to the preview's longer side, for the shot card. */
+static vf_status load_nearest_photo(const export_run *run, target *t, int side)
+{
+    if (t->trust.nearest < 0)
+        return VF_OK;
+    static const float white[3] = {1, 1, 1};
+    vf_image full;
+    vf_status status =
+        vf_image_load_rgb(run->photos.frames[t->trust.nearest].image_path, white, &full);
+    if (status != VF_OK)
+        return status;
+    double s = (double)side / (full.width > full.height ? full.width : full.height);
+    int w = (int)(full.width * s + 0.5), h = (int)(full.height * s + 0.5);
+    status = vf_image_resize(&full, w > 0 ? w : 1, h > 0 ? h : 1, &t->photo);
+    vf_image_free(&full);
+    return status;
 }
 
 /* Classify a preview when attack.json does not say what the model predicts there. */
@@ -174,6 +212,8 @@ static vf_status render_previews(export_run *run, const char *dir)
             status = vf_image_save(path, &t->preview);
         if (status == VF_OK && t->pred.cls < 0)
             status = predict_preview(run, t);
+        if (status == VF_OK)
+            status = load_nearest_photo(run, t, PREVIEW_SIZE);
     }
     return status;
 }
@@ -217,6 +257,16 @@ static json_t *target_json(const export_run *run, int i)
             o, "prediction",
             json_pack("{s:i, s:s, s:o, s:b}", "class", t->pred.cls, "name", t->pred.name,
                       "confidence", vf_json_number(t->pred.confidence), "fooled", t->pred.fooled));
+    if (!isnan(t->trust.gap_deg)) {
+        char photo[VF_PATH_MAX];
+        vf_path_basename(photo, sizeof photo, run->photos.frames[t->trust.nearest].image_path, 0);
+        json_object_set_new(
+            o, "trust",
+            json_pack("{s:o, s:o, s:b, s:s, s:o, s:o}", "gap_deg", vf_json_number(t->trust.gap_deg),
+                      "gap_limit_deg", vf_json_number(run->trust_limit), "trusted", trusted(run, t),
+                      "nearest_photo", photo, "angle_deg", vf_json_number(t->trust.angle_deg),
+                      "distance_ratio", vf_json_number(t->trust.distance_ratio)));
+    }
     if (t->preview.data) {
         char name[48];
         snprintf(name, sizeof name, "previews/target_%02d.png", i);
@@ -240,6 +290,7 @@ static void fill_tile(const export_run *run, int i, shot_tile *tile)
     char d[32], h[32];
     memset(tile, 0, sizeof *tile);
     tile->preview = t->preview.data ? &t->preview : NULL;
+    tile->photo = t->photo.data ? &t->photo : NULL;
     snprintf(tile->title, sizeof tile->title, "target %d: %s", i,
              t->sample < 0 ? "v* (strongest)" : "sample of p*(v)");
     distance_text(run, w->distance, d, sizeof d);
@@ -256,6 +307,11 @@ static void fill_tile(const export_run *run, int i, shot_tile *tile)
                  t->pred.name, 100 * t->pred.confidence, t->pred.fooled ? " - fooled" : "");
     else
         snprintf(tile->lines[4], sizeof tile->lines[4], "predicted: unknown");
+    if (!isnan(t->trust.gap_deg))
+        snprintf(tile->lines[5], sizeof tile->lines[5], "trust: %.0f deg from the nearest photo%s",
+                 t->trust.gap_deg, trusted(run, t) ? "" : " - BEYOND the limit");
+    else
+        snprintf(tile->lines[5], sizeof tile->lines[5], "trust: unknown (no photos)");
 }
 
 static vf_status write_csv(const export_run *run, const char *path)
@@ -267,7 +323,7 @@ static vf_status write_csv(const export_run *run, const char *path)
         return vf_fail(VF_EINTERNAL, "out of memory");
     fprintf(f, "index,kind,psi,theta,phi,dx,dy,dz,azimuth_deg,elevation_deg,distance,height,"
                "roll_deg,look_x,look_y,look_z,distance_m,predicted_class,predicted_name,fooled,"
-               "colmap_cam_x,colmap_cam_y,colmap_cam_z\n");
+               "colmap_cam_x,colmap_cam_y,colmap_cam_z,gap_deg,trusted\n");
     for (int i = 0; i < run->target_count; i++) {
         const target *t = &run->targets[i];
         const vf_target_words *w = &t->words;
@@ -285,9 +341,13 @@ static vf_status write_csv(const export_run *run, const char *path)
             fprintf(f, ",,,");
         }
         if (run->has_colmap)
-            fprintf(f, ",%.9g,%.9g,%.9g\n", t->c2w_colmap[3], t->c2w_colmap[7], t->c2w_colmap[11]);
+            fprintf(f, ",%.9g,%.9g,%.9g", t->c2w_colmap[3], t->c2w_colmap[7], t->c2w_colmap[11]);
         else
-            fprintf(f, ",,,\n");
+            fprintf(f, ",,,");
+        if (!isnan(t->trust.gap_deg))
+            fprintf(f, ",%.4g,%d\n", t->trust.gap_deg, trusted(run, t));
+        else
+            fprintf(f, ",,\n");
     }
     fclose(f);
     vf_status status = vf_write_file_atomic(path, text, size);
@@ -299,6 +359,15 @@ static vf_status write_outputs(export_run *run, const char *dir, json_t **summar
                                json_t **targets)
 {
     char path[VF_PATH_MAX];
+    int beyond = 0;
+    for (int i = 0; i < run->target_count; i++)
+        beyond += !isnan(run->targets[i].trust.gap_deg) && !trusted(run, &run->targets[i]);
+    if (beyond)
+        vf_warn("%d of the %d targets (%s) lie beyond %.0f deg from the nearest photo: the "
+                "field may be wrong there, so a re-shoot there tests the field as much as the "
+                "classifier",
+                beyond, run->target_count, trusted(run, &run->targets[0]) ? "v* is not" : "v* too",
+                run->trust_limit);
     vf_status status = render_previews(run, dir);
     json_t *list = json_array();
     for (int i = 0; i < run->target_count; i++)
@@ -338,9 +407,13 @@ static vf_status write_outputs(export_run *run, const char *dir, json_t **summar
 
 static void export_free(export_run *run)
 {
-    for (int i = 0; run->targets && i < run->target_count; i++)
+    for (int i = 0; run->targets && i < run->target_count; i++) {
         vf_image_free(&run->targets[i].preview);
+        vf_image_free(&run->targets[i].photo);
+    }
     free(run->targets);
+    free(run->photo_c2w);
+    vf_dataset_free(&run->photos);
     vf_attack_file_free(&run->attack);
     vf_field_free(run->field);
     vf_classifier_close(run->cls);

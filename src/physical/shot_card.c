@@ -9,10 +9,10 @@
 #include "vf/fsutil.h"
 
 #define COLUMNS 4
-#define PREVIEW 224   /* previews are drawn scaled to this square */
-#define TILE_W 300
+#define PREVIEW 200 /* the preview and the photo are drawn fitted in squares of this side */
+#define TILE_W (2 * PREVIEW + 24)
 #define LINE_H 15
-#define TILE_H (PREVIEW + 30 + LINE_H * SHOT_CARD_LINES + 12)
+#define TILE_H (PREVIEW + 30 + LINE_H * (SHOT_CARD_LINES + 1) + 12)
 #define MARGIN 16
 #define HEADING_H 40
 
@@ -41,37 +41,50 @@ static cairo_surface_t *preview_surface(const vf_image *img)
     return s;
 }
 
+/* img fitted in the square at (x, y), keeping its aspect; a grey square saying `missing`
+ * when there is none. */
+static void draw_fitted(cairo_t *cr, const vf_image *img, double x, double y, const char *missing)
+{
+    if (!img || !img->data) {
+        cairo_set_source_rgb(cr, 0.85, 0.85, 0.85);
+        cairo_rectangle(cr, x, y, PREVIEW, PREVIEW);
+        cairo_fill(cr);
+        cairo_set_source_rgb(cr, 0.4, 0.4, 0.4);
+        cairo_set_font_size(cr, 11);
+        cairo_move_to(cr, x + 10, y + PREVIEW / 2.0);
+        cairo_show_text(cr, missing);
+        return;
+    }
+    double s = (double)PREVIEW / (img->width > img->height ? img->width : img->height);
+    cairo_surface_t *surface = preview_surface(img);
+    cairo_save(cr);
+    cairo_translate(cr, x + (PREVIEW - s * img->width) / 2, y + (PREVIEW - s * img->height) / 2);
+    cairo_scale(cr, s, s);
+    cairo_set_source_surface(cr, surface, 0, 0);
+    cairo_paint(cr);
+    cairo_restore(cr);
+    cairo_surface_destroy(surface);
+}
+
 static void draw_tile(cairo_t *cr, const shot_tile *t, double x0, double y0)
 {
-    double px = x0 + (TILE_W - PREVIEW) / 2.0, py = y0 + 24;
+    double px = x0 + 4, py = y0 + 24;
     cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
     cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
     cairo_set_font_size(cr, 13);
     cairo_move_to(cr, x0 + 4, y0 + 16);
     cairo_show_text(cr, t->title);
-    if (t->preview && t->preview->data) {
-        cairo_surface_t *s = preview_surface(t->preview);
-        cairo_save(cr);
-        cairo_translate(cr, px, py);
-        cairo_scale(cr, (double)PREVIEW / t->preview->width, (double)PREVIEW / t->preview->height);
-        cairo_set_source_surface(cr, s, 0, 0);
-        cairo_paint(cr);
-        cairo_restore(cr);
-        cairo_surface_destroy(s);
-    } else {
-        cairo_set_source_rgb(cr, 0.85, 0.85, 0.85);
-        cairo_rectangle(cr, px, py, PREVIEW, PREVIEW);
-        cairo_fill(cr);
-        cairo_set_source_rgb(cr, 0.4, 0.4, 0.4);
-        cairo_set_font_size(cr, 12);
-        cairo_move_to(cr, px + 40, py + PREVIEW / 2.0);
-        cairo_show_text(cr, "no preview (no trained field)");
-    }
-    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
     cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    draw_fitted(cr, t->preview, px, py, "no preview (no trained field)");
+    draw_fitted(cr, t->photo, px + PREVIEW + 8, py, "no photo");
+    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
     cairo_set_font_size(cr, 11.5);
+    cairo_move_to(cr, px, py + PREVIEW + 14);
+    cairo_show_text(cr, "the field's render here");
+    cairo_move_to(cr, px + PREVIEW + 8, py + PREVIEW + 14);
+    cairo_show_text(cr, "the nearest photo");
     for (int i = 0; i < SHOT_CARD_LINES && t->lines[i][0]; i++) {
-        cairo_move_to(cr, x0 + 4, py + PREVIEW + 18 + LINE_H * i);
+        cairo_move_to(cr, px, py + PREVIEW + 18 + LINE_H * (i + 1));
         cairo_show_text(cr, t->lines[i]);
     }
 }
