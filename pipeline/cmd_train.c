@@ -160,16 +160,21 @@ int cmd_train(int argc, char **argv)
     double ssim = json_number_value(json_object_get(report, "held_out_ssim"));
     double steps = json_number_value(json_object_get(report, "steps"));
     double seconds = json_number_value(json_object_get(report, "seconds"));
+    char fit[96] = "";
+    if (json_object_get(report, "psnr_gap"))
+        snprintf(fit, sizeof fit, "; training views %.2f dB (%.1f dB above)",
+                 json_number_value(json_object_get(report, "training_psnr")),
+                 json_number_value(json_object_get(report, "psnr_gap")));
     if (opt.flags.json)
         cli_print_json(json_pack("{s:s, s:O}", "model", model, "report", report));
     else if (json_object_get(report, "held_out_psnr_object"))
         printf("trained %.0f steps in %.0f s; held-out views: PSNR %.2f dB inside the "
-               "object's masks (%.2f dB with the white around), SSIM %.3f\n",
-               steps, seconds,
-               json_number_value(json_object_get(report, "held_out_psnr_object")), psnr, ssim);
+               "object's masks (%.2f dB with the white around), SSIM %.3f%s\n",
+               steps, seconds, json_number_value(json_object_get(report, "held_out_psnr_object")),
+               psnr, ssim, fit);
     else if (json_object_get(report, "held_out_psnr"))
-        printf("trained %.0f steps in %.0f s; held-out views: PSNR %.2f dB, SSIM %.3f\n", steps,
-               seconds, psnr, ssim);
+        printf("trained %.0f steps in %.0f s; held-out views: PSNR %.2f dB, SSIM %.3f%s\n", steps,
+               seconds, psnr, ssim, fit);
     else
         printf("trained %.0f steps in %.0f s\n", steps, seconds);
     json_decref(report);

@@ -20,6 +20,15 @@ for f in train/model.vff train/report.json train/held_out.jpg "attack/$attack/at
 done
 python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["held_out_psnr"] > 22, r["held_out_psnr"]' "$ws/train/report.json" \
   && ok || bad "held-out PSNR after 500 steps is above 22 dB (a white image scores 14.4 dB): $(cat "$ws/train/report.json" | head -c 300)"
+python3 -c '
+import json, sys
+r = json.load(open(sys.argv[1]))
+held, fit = r["held_out"], r["training_scored"]
+assert len(held) <= len(fit) <= len(held) + 2, (len(held), len(fit))
+held_psnr = r.get("held_out_psnr_object", r["held_out_psnr"])  # inside the masks when given
+assert abs(r["psnr_gap"] - (r["training_psnr"] - held_psnr)) < 1e-9, r
+assert abs(r["psnr_gap"]) < 4, r["psnr_gap"]' "$ws/train/report.json" \
+  && ok || bad "train scores as many training views and reports the train/held-out gap (under 4 dB on the chair): $(cat "$ws/train/report.json" | head -c 400)"
 python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["surroundings"] == "none" and "background-removed" in r["field"], r' "$ws/train/report.json" \
   && ok || bad "auto: no outer grid for the chair's transparent background, and the report says so"
 python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); assert r["color"] == "view" and r["view_smoothing"] == 0, r' "$ws/train/report.json" \

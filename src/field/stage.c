@@ -264,6 +264,15 @@ static vf_status save_view(const char *dir, int index, const vf_image *render,
     return status;
 }
 
+/* Whether frame i is one `how` scores (k counts the frames its rule picks before i). */
+static int scored(const vf_photo_scoring *how, int i, int *k)
+{
+    int picked = !how->holdout || is_held_out(i, how->holdout) != how->training;
+    if (!picked)
+        return 0;
+    return (*k)++ % (how->stride > 1 ? how->stride : 1) == 0;
+}
+
 vf_status vf_field_score_photos(const vf_field *f, const vf_dataset *views,
                                 const vf_photo_scoring *how, json_t *list, vf_photo_scores *out)
 {
@@ -274,12 +283,13 @@ vf_status vf_field_score_photos(const vf_field *f, const vf_dataset *views,
     vf_image sheet[2 * SHEET_PAIRS] = {{0}};
     char captions[2 * SHEET_PAIRS][96];
     vf_status status = VF_OK;
-    for (int i = 0; i < views->count; i++)
-        chosen += !how->holdout || is_held_out(i, how->holdout);
+    for (int i = 0, k = 0; i < views->count; i++)
+        chosen += scored(how, i, &k);
     vf_progress progress;
-    vf_progress_begin(&progress, "scoring", (size_t)chosen, "views");
-    for (int i = 0; i < views->count && status == VF_OK; i++) {
-        if (how->holdout && !is_held_out(i, how->holdout))
+    vf_progress_begin(&progress, how->training ? "scoring training views" : "scoring",
+                      (size_t)chosen, "views");
+    for (int i = 0, k = 0; i < views->count && status == VF_OK; i++) {
+        if (!scored(how, i, &k))
             continue;
         const vf_frame *frame = &views->frames[i];
         vf_image raw = {0}, photo = {0}, render = {0}; /* raw: a cut-out's alpha is its mask */
@@ -450,6 +460,18 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                                        held_out, &scores);
     json_object_set_new(report, "held_out", held_out);
     psnr = scores.psnr, ssim = scores.ssim, psnr_object = scores.psnr_object;
+    /* as many training views, spread over them: the gap between the two is the sign of a
+     * field that fits its photos and is fog between them */
+    vf_photo_scores fit = {0, NAN, NAN, NAN};
+    json_t *training = json_array();
+    if (status == VF_OK && held > 0)
+        status = vf_field_score_photos(field, &views,
+                                       &(vf_photo_scoring){.holdout = opt->holdout,
+                                                           .training = 1,
+                                                           .stride = (views.count - held) / held,
+                                                           .object_cut = opt->object_only},
+                                       training, &fit);
+    json_object_set_new(report, "training_scored", training);
     if (status == VF_OK)
         status = vf_path_join(model, sizeof model, stage.dir, VF_FIELD_FILE);
     if (status == VF_OK)
@@ -493,6 +515,19 @@ vf_status vf_train_run(vf_workspace *ws, const vf_train_options *opt, json_t **r
                                              "held_out_ssim", vf_json_number(ssim)));
         if (held && isfinite(psnr_object))
             json_object_set_new(report, "held_out_psnr_object", vf_json_number(psnr_object));
+        if (held && fit.count > 0) {
+            int masked = isfinite(psnr_object) && isfinite(fit.psnr_object);
+            double fit_psnr = masked ? fit.psnr_object : fit.psnr,
+                   gap = fit_psnr - (masked ? psnr_object : psnr);
+            json_object_update_new(report, json_pack("{s:o, s:o}", "training_psnr",
+                                                     vf_json_number(fit_psnr), "psnr_gap",
+                                                     vf_json_number(gap)));
+            if (gap > VF_TRAIN_GAP_WARN_DB)
+                vf_warn("the held-out photos render %.1f dB below the training views: the field "
+                        "fits its photos and guesses between them; look at WS/train/held_out.jpg, "
+                        "and film more views between the photos",
+                        gap);
+        }
         status = vf_path_join(report_path, sizeof report_path, stage.dir, "report.json");
     }
     if (status == VF_OK)
