@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "vf/cutout.h"
 #include "vf/dataset.h"
 #include "vf/json.h"
 #include "vf/log.h"
@@ -18,7 +19,10 @@ static const char usage[] =
     "frame; a posed set's own test set is moved there when the poses stage moved the set)\n"
     "with the trained field of WS at the frame's own resolution and camera, and report\n"
     "PSNR and SSIM per view and on average. Transparent test pixels are composited onto the\n"
-    "field's background colour. With -o, the renders and error images are saved there.\n"
+    "field's background colour. Where WS has the sparse points of 'vfcapture poses', each\n"
+    "render is also checked for the object where its photo shows it (the overlap of the\n"
+    "photo's cut-out with the render's surfaces at the object; under 0.5: missing, as train\n"
+    "checks its held-out views). With -o, the renders and error images are saved there.\n"
     "\n"
     "options:\n"
     "      --transforms PATH  the posed test set\n"
@@ -83,23 +87,40 @@ int cmd_eval(int argc, char **argv)
     }
     json_t *views = json_array();
     vf_photo_scores scores;
-    status = vf_field_score_photos(field, &test, &(vf_photo_scoring){.save_dir = opt.out}, views,
-                                   &scores);
+    vf_object_points object = {0};
+    vf_train_object_points(&ws, field, &test, &object);
+    status = vf_field_score_photos(
+        field, &test,
+        &(vf_photo_scoring){.save_dir = opt.out, .object = object.count ? &object : NULL}, views,
+        &scores);
+    vf_object_points_free(&object);
     if (status == VF_OK && opt.flags.json) {
-        cli_print_json(json_pack("{s:s, s:i, s:o, s:o, s:O}", "transforms", opt.transforms, "views",
-                                 test.count, "psnr", vf_json_number(scores.psnr), "ssim",
-                                 vf_json_number(scores.ssim), "per_view", views));
+        cli_print_json(json_pack("{s:s, s:i, s:o, s:o, s:o, s:i, s:O}", "transforms",
+                                 opt.transforms, "views", test.count, "psnr",
+                                 vf_json_number(scores.psnr), "ssim", vf_json_number(scores.ssim),
+                                 "object_iou_mean", vf_json_number(scores.object_iou_mean),
+                                 "object_missing", scores.object_missing, "per_view", views));
     } else if (status == VF_OK) {
         size_t i;
         json_t *v;
         json_array_foreach(views, i, v)
         {
-            printf("  %-28s PSNR %6.2f dB  SSIM %.4f\n",
+            const json_t *iou = json_object_get(v, "object_iou");
+            printf("  %-28s PSNR %6.2f dB  SSIM %.4f",
                    json_string_value(json_object_get(v, "image")),
                    json_number_value(json_object_get(v, "psnr")),
                    json_number_value(json_object_get(v, "ssim")));
+            if (json_is_number(iou))
+                printf("  object %.2f%s", json_number_value(iou),
+                       json_number_value(iou) < VF_OBJECT_PRESENT_IOU ? " (missing)" : "");
+            printf("\n");
         }
         printf("%d views: mean PSNR %.2f dB, SSIM %.4f\n", test.count, scores.psnr, scores.ssim);
+        if (scores.object_checked)
+            printf("the object is in %d of %d renders (overlap with the photo's cut-out %.2f on "
+                   "average)\n",
+                   scores.object_checked - scores.object_missing, scores.object_checked,
+                   scores.object_iou_mean);
     }
     json_decref(views);
     vf_field_free(field);

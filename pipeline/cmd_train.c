@@ -12,9 +12,11 @@ static const char usage[] =
     "\n"
     "Fit a radiance field (an explicit density + spherical-harmonics grid, coarse to fine) to\n"
     "the posed images of WS: the undistorted frames of the poses stage, or an imported posed\n"
-    "set. Every Nth view is held out and its PSNR reported. An interrupted run continues from\n"
-    "its last checkpoint. Writes WS/train/model.vff, report.json and held_out.jpg (held-out\n"
-    "photos beside their renders).\n"
+    "set. Every Nth view is held out and its PSNR reported, beside as many training views\n"
+    "(a held-out PSNR far below theirs: fog between the photos); with the sparse points of\n"
+    "'vfcapture poses', each held-out render is also checked for the object where its photo\n"
+    "shows it. An interrupted run continues from its last checkpoint. Writes\n"
+    "WS/train/model.vff, report.json and held_out.jpg (held-out photos beside their renders).\n"
     "\n"
     "options:\n"
     "      --minutes M        training wall time (default 3; 5 for a 3D model's workspace)\n"
@@ -177,6 +179,17 @@ int cmd_train(int argc, char **argv)
                seconds, psnr, ssim, fit);
     else
         printf("trained %.0f steps in %.0f s\n", steps, seconds);
+    const json_t *check = json_object_get(report, "object_check");
+    if (check && !opt.flags.json)
+        printf("the object is in %lld of %lld held-out renders (overlap with the photo's cut-out "
+               "%.2f on average, %.2f at worst; training views %.2f%s)\n",
+               json_integer_value(json_object_get(check, "views")) -
+                   json_integer_value(json_object_get(check, "missing")),
+               json_integer_value(json_object_get(check, "views")),
+               json_number_value(json_object_get(check, "iou_mean")),
+               json_number_value(json_object_get(check, "iou_min")),
+               json_number_value(json_object_get(check, "training_iou_mean")),
+               json_is_true(json_object_get(check, "conclusive")) ? "" : ": inconclusive");
     json_decref(report);
     return 0;
 }

@@ -9,12 +9,13 @@
  *
  * Where the object is comes from the poses stage's sparse points (WS/poses/points3D.txt, in
  * the object frame: the object at the origin, cameras at a mean distance of 4):
- *   1. points within `radius` of the origin are candidates (the rest is the room);
+ *   1. points within `radius` of the origin (or a given centre) are candidates (the rest is
+ *      the room);
  *   2. the surface the object stands on (or hangs from) is the dominant plane among them
  *      (RANSAC, seeded) when it holds 15% of them and more of the rest lie in front of it
  *      (towards the cameras) than behind: its points, and those behind it, are dropped;
  *   3. the rest is grouped by single linkage (3 times the median distance between
- *      neighbours); the group with the most points within radius / 2 of the origin (the point
+ *      neighbours); the group with the most points within radius / 2 of the centre (the point
  *      the cameras look at lies in or near the object) is the object, with every other group
  *      near the origin at least a third its size (an object in parts: a pair of shoes);
  *   2'. a dominant plane with more points behind it than in front is the object's own face (a
@@ -25,8 +26,9 @@
  * shrunk copy: the points well inside their projected convex hull are sure object, the hull
  * (of the points and their footprints on the surface: an object stands on it, and its
  * untextured sides have no points) probable object, a margin around it probable background
- * and the photo beyond sure background; GrabCut's colour models decide the pixels between. The mask keeps the
- * connected regions that hold object points, is scaled back up and becomes the alpha channel.
+ * and the photo beyond sure background; GrabCut's colour models decide the pixels between. The mask
+ * keeps the connected regions that hold object points, is scaled back up and becomes the alpha
+ * channel.
  *
  * Memory: vf_object_points owns its array (vf_object_points_free); a mask is malloc'd
  * width * height bytes (0 or 255) the caller frees. */
@@ -46,7 +48,9 @@ extern "C" {
 #endif
 
 typedef struct vf_cutout_options {
-    double radius;          /* candidates within this distance of the origin (default 2) */
+    double centre[3];       /* where the object is looked for (default the origin: the point
+                               the cameras look at; train's check uses its object box's) */
+    double radius;          /* candidates within this distance of the centre (default 2) */
     double plane_tolerance; /* a point this close to the plane is on it (default 0.06) */
     int max_side;           /* GrabCut's working size, longer side in pixels (default 480) */
     int iterations;         /* GrabCut iterations (default 5) */

@@ -79,6 +79,12 @@ vf_status vf_field_render_viewpoints(const vf_field *f, const vf_camera *cam,
 vf_status vf_field_render_opacity(const vf_field *f, const vf_camera *cam, const double c2w[16],
                                   vf_image *out);
 
+/* The distance along each pixel's ray (world units; the ray's direction is a unit vector) to
+ * the surface it sees: the opacity-weighted mean distance of its samples where the opacity is
+ * over a half, else INFINITY (one channel, (re)allocated as in vf_field_render). */
+vf_status vf_field_render_depth(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                                vf_image *out);
+
 /* The pinhole camera whose size x size image equals what a classifier sees of a training
  * photo: the photo resized so its shorter side is size * 256 / 224, then centre-cropped to
  * size x size (vf_classifier_preprocess). Lens distortion is dropped. */

@@ -19,8 +19,13 @@
  * depth loss, which drops any that fall outside their photo; 0 when it was off or had none],
  * held_out_psnr/ssim, held_out [per view], training_psnr [as many training views, spread
  * over them, scored the same way; training_scored per view], psnr_gap [training_psnr minus
- * held_out_psnr, inside the masks in object mode]), held_out.jpg. A gap over
- * VF_TRAIN_GAP_WARN_DB is a warning: the field fits its photos and is fog between them. */
+ * held_out_psnr, inside the masks in object mode], object_check [where a poses stage's
+ * sparse points show the object: {views, missing, iou_mean, iou_min, training_views,
+ * training_missing, training_iou_mean, present_iou, conclusive}, the object's overlap in
+ * held-out photo and render, vf_photo_scoring; conclusive when the training views' mean
+ * reaches present_iou]), held_out.jpg. A gap over VF_TRAIN_GAP_WARN_DB is a warning: the
+ * field fits its photos and is fog between them; so are held-out views without the object
+ * clearly more often (by a quarter of them) than the training views, when conclusive. */
 #ifndef VF_TRAIN_H
 #define VF_TRAIN_H
 
@@ -88,6 +93,8 @@ vf_status vf_train_options_check(const vf_train_options *o);
  * reference). VF_EINPUT when there are fewer than 3 training views. */
 vf_status vf_train_run(vf_workspace *ws, const vf_train_options *o, json_t **result);
 
+struct vf_object_points;
+
 /* Scoring a field against posed photos: the held-out views of `train` and the test sets of
  * `eval` go through the same loop. Each chosen photo is rendered at its pose and compared. */
 typedef struct vf_photo_scoring {
@@ -98,16 +105,39 @@ typedef struct vf_photo_scoring {
     int object_cut;         /* cut each photo by the field's silhouette first (object mode) */
     const char *sheet_path; /* NULL, or a contact sheet of the first photo | render pairs */
     const char *save_dir;   /* NULL, or DIR/render_NNN.png and DIR/error_NNN.png per view */
+    /* NULL, or the object's sparse points (vf/cutout.h): each view is also checked for the
+     * object being where its photo shows it. The photo's cut-out (GrabCut seeded by those
+     * points: the photo alone decides) against the render's pixels whose surface lies in the
+     * object's region (the points' box grown by a tenth, in front of the surface it stands
+     * on: the field alone decides), as intersection over union at the cut-out's working size.
+     * Fog before the object, or the room seen through where it should be, leaves the
+     * render's pixels out. */
+    const struct vf_object_points *object;
 } vf_photo_scoring;
+
+/* A view shows the object when that overlap is at least this. */
+#define VF_OBJECT_PRESENT_IOU 0.5
 
 typedef struct vf_photo_scores {
     int count;                /* views scored */
     double psnr, ssim;        /* means (NAN without views) */
     double psnr_object;       /* mean PSNR inside the photos' masks: photos with alpha, or
                                  cut in object mode (else NAN) */
+    int object_checked;       /* with `object`: views whose photo shows the object's points */
+    int object_missing;       /* of those, views under VF_OBJECT_PRESENT_IOU */
+    double object_iou_mean, object_iou_min; /* over them (NAN without) */
 } vf_photo_scores;
 
-/* Score; `list` (a JSON array) gets {"image", "psnr", "ssim"} per view. Shows progress. */
+/* The object's sparse points for that check, found as object mode finds them (vf/cutout.h),
+ * or, where there are none near the point the cameras look at, around the field's object box,
+ * where the photos' middles are (the fruit on the bed of banana_apple_photos lies 1.1 units
+ * from that point). out->count is 0 (nothing to free) without a poses stage (posed imports, 3D models)
+ * or where the points show no object there (said in an info line). */
+void vf_train_object_points(const vf_workspace *ws, const vf_field *field, const vf_dataset *views,
+                            struct vf_object_points *out);
+
+/* Score; `list` (a JSON array) gets {"image", "psnr", "ssim"} per view, and "object_iou" with
+ * `object` (null where the photo shows none of its points). Shows progress. */
 vf_status vf_field_score_photos(const vf_field *f, const vf_dataset *views,
                                 const vf_photo_scoring *how, json_t *list, vf_photo_scores *out);
 

@@ -46,6 +46,12 @@ static double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+static double distance3(const double *a, const double *b)
+{
+    const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    return sqrt(dot3(d, d));
+}
+
 /* The plane through three points (n unit, n.x + d = 0); 0 when they are nearly collinear. */
 static int plane_through(const double *a, const double *b, const double *c, double plane[4])
 {
@@ -100,7 +106,7 @@ static int find_root(int *parent, int i)
  * the cameras look at lies in or near the object), with every group at least a third its size
  * that also reaches there (an object in parts: a pair of shoes is two groups of 600 and 555
  * points), moved to the front of p; *kept gets their size. */
-static vf_status central_cluster(double *p, int n, double radius, int *kept)
+static vf_status central_cluster(double *p, int n, const double centre[3], double radius, int *kept)
 {
     *kept = 0;
     if (n == 0)
@@ -141,7 +147,7 @@ static vf_status central_cluster(double *p, int n, double radius, int *kept)
     int best = -1;
     for (int i = 0; i < n; i++) {
         int r = find_root(parent, i);
-        const int near = sqrt(dot3(p + 3 * i, p + 3 * i)) < radius / 2;
+        const int near = distance3(p + 3 * i, centre) < radius / 2;
         size[r]++;
         score[r] += 1 + 1000 * near;
         if (best < 0 || score[r] > score[best])
@@ -174,7 +180,7 @@ vf_status vf_object_points_find(const char *points_dir, const double *cameras, i
         return vf_fail(VF_EINTERNAL, "out of memory");
     }
     for (int i = 0; i < model.point_count; i++)
-        if (sqrt(dot3(model.points[i].xyz, model.points[i].xyz)) < o->radius)
+        if (distance3(model.points[i].xyz, o->centre) < o->radius)
             memcpy(cand + 3 * n++, model.points[i].xyz, 3 * sizeof *cand);
     vf_colmap_model_free(&model);
     out->candidates = n;
@@ -219,7 +225,7 @@ vf_status vf_object_points_find(const char *points_dir, const double *cameras, i
                 memmove(cand + 3 * kept++, cand + 3 * i, 3 * sizeof *cand);
     } else {
         /* the object: the cluster of what is left that lies at the centre of attention */
-        status = central_cluster(cand, n, o->radius, &kept);
+        status = central_cluster(cand, n, o->centre, o->radius, &kept);
     }
     if (status != VF_OK) {
         free(cand);

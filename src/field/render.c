@@ -107,33 +107,39 @@ void vf__field_render_depth(const vf_field *f, const field_render_setup *setup,
     render_image(f, setup, cam, c2w, RENDER_DEPTH, depth, 1);
 }
 
-/* One image, its bands spread over the cores: colour (3 channels) or opacity (1). */
+/* One image, its bands spread over the cores: colour (3 channels), opacity or depth (1). */
 static vf_status render_one(const vf_field *f, const vf_camera *cam, const double c2w[16],
-                            int opacity, vf_image *out)
+                            render_output what, vf_image *out)
 {
     vf_status status = check_camera(cam);
     if (status == VF_OK)
         status = check_poses(c2w, 1);
     if (status == VF_OK)
-        status = ensure_image(out, cam->width, cam->height, opacity ? 1 : 3);
+        status = ensure_image(out, cam->width, cam->height, what == RENDER_RGB ? 3 : 1);
     field_render_setup setup;
     if (status == VF_OK)
         status = vf__field_render_setup_init(f, &setup);
     if (status == VF_OK)
-        render_image(f, &setup, cam, c2w, opacity ? RENDER_OPACITY : RENDER_RGB, out->data, 1);
+        render_image(f, &setup, cam, c2w, what, out->data, 1);
     return status;
 }
 
 vf_status vf_field_render(const vf_field *f, const vf_camera *cam, const double c2w[16],
                           vf_image *out)
 {
-    return render_one(f, cam, c2w, 0, out);
+    return render_one(f, cam, c2w, RENDER_RGB, out);
 }
 
 vf_status vf_field_render_opacity(const vf_field *f, const vf_camera *cam, const double c2w[16],
                                   vf_image *out)
 {
-    return render_one(f, cam, c2w, 1, out);
+    return render_one(f, cam, c2w, RENDER_OPACITY, out);
+}
+
+vf_status vf_field_render_depth(const vf_field *f, const vf_camera *cam, const double c2w[16],
+                                vf_image *out)
+{
+    return render_one(f, cam, c2w, RENDER_DEPTH, out);
 }
 
 vf_status vf_field_render_batch(const vf_field *f, const vf_camera *cam, const double *c2w, int n,
