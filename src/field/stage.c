@@ -311,6 +311,7 @@ static vf_status save_view(const char *dir, int index, const vf_image *render,
                           share exceeds the training views' by this */
 #define REGION_LINK 3  /* the region's cell: this many times the points' median spacing */
 #define REGION_REACH 1 /* cells around a cell with a point that belong to the region */
+#define REGION_MIN_CELLS 24 /* and at least this share of the points' longest extent */
 
 /* The object's region: the cells of a grid over its sparse points that hold one, and their
  * neighbours; a cell is three times the points' median spacing (the link of vf/cutout.h's
@@ -343,7 +344,8 @@ static vf_status object_region_make(const vf_object_points *pts, object_region *
     }
     vf_sort_doubles(nearest, n);
     const double side = fmax(hi[0] - r->lo[0], fmax(hi[1] - r->lo[1], hi[2] - r->lo[2]));
-    r->cell = fmax(REGION_LINK * sqrt(vf_sorted_quantile(nearest, n, 0.5)), side / 256);
+    r->cell =
+        fmax(REGION_LINK * sqrt(vf_sorted_quantile(nearest, n, 0.5)), side / REGION_MIN_CELLS);
     r->side = side;
     free(nearest);
     if (!(r->cell > 0 && isfinite(r->cell)))
@@ -421,19 +423,20 @@ static int object_region_shows(const object_region *r, const double o[3], const 
 }
 
 /* The object's overlap in a photo and the field's render of it (vf_photo_scoring.object);
- * *iou gets -1 when the photo shows fewer than 3 of the object's points. */
+ * *iou gets -1 when the photo shows fewer than 3 of the object's points. A photo with its
+ * background removed is its own cut-out (`alpha`, camera-sized, or NULL: GrabCut cuts it). */
 static vf_status object_overlap(const vf_field *f, const vf_frame *frame,
                                 const vf_object_points *pts, const object_region *region,
-                                double *iou)
+                                uint8_t *alpha, double *iou)
 {
     *iou = -1;
     vf_rgb8 photo = {0};
-    uint8_t *mask = NULL;
-    int seen = 0;
+    uint8_t *mask = alpha;
+    int seen = 3;
     vf_cutout_options o;
     vf_cutout_defaults(&o);
-    vf_status status = vf_rgb8_load(frame->image_path, &photo);
-    if (status == VF_OK)
+    vf_status status = alpha ? VF_OK : vf_rgb8_load(frame->image_path, &photo);
+    if (status == VF_OK && !alpha)
         status = vf_cutout_mask(&photo, &frame->camera, frame->c2w, pts, &o, &mask, &seen);
     vf_rgb8_free(&photo);
     const vf_camera *full = &frame->camera;
@@ -472,7 +475,8 @@ static vf_status object_overlap(const vf_field *f, const vf_frame *frame,
         *iou = either ? (double)both / (double)either : -1;
     }
     vf_image_free(&depth);
-    free(mask);
+    if (mask != alpha)
+        free(mask);
     return status;
 }
 
@@ -520,12 +524,22 @@ vf_status vf_field_score_photos(const vf_field *f, const vf_dataset *views,
             if (p >= 0)
                 object_sum += p, object_n++;
         }
+        uint8_t *alpha = NULL; /* a background-removed photo's own cut-out (not object mode's:
+                                  that alpha is the field's silhouette) */
+        if (status == VF_OK && how->object && raw.channels == 4 && !how->object_cut) {
+            const size_t pixels = (size_t)raw.width * raw.height;
+            if (!(alpha = malloc(pixels)))
+                status = vf_fail(VF_EINTERNAL, "out of memory");
+            for (size_t i = 0; alpha && i < pixels; i++)
+                alpha[i] = raw.data[4 * i + 3] > 0.5f;
+        }
         vf_image_free(&raw);
         if (status == VF_OK && how->save_dir)
             status = save_view(how->save_dir, n, &render, &photo);
         double iou = -1;
         if (status == VF_OK && how->object)
-            status = object_overlap(f, frame, how->object, &region, &iou);
+            status = object_overlap(f, frame, how->object, &region, alpha, &iou);
+        free(alpha);
         if (iou >= 0) {
             iou_sum += iou, iou_n++;
             iou_min = fmin(iou_min, iou);
