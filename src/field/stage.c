@@ -138,13 +138,13 @@ void vf_train_object_points(const vf_workspace *ws, const vf_field *field, const
         status = vf_object_points_find(dir, cameras, views->count, &o, out);
     }
     if (status != VF_OK) {
-        vf_info("the held-out renders are not checked for the object: %s", vf_error_message());
+        vf_info("the renders are not checked for the object: %s", vf_error_message());
         vf_error_clear();
         vf_object_points_free(out);
         memset(out, 0, sizeof *out);
     } else {
-        vf_info("held-out renders checked for the object: %d of the %d sparse points near the "
-                "object box are the object%s",
+        vf_info("renders checked for the object: %d of the %d sparse points near it are the "
+                "object%s",
                 out->count, out->candidates,
                 out->has_plane ? ", the surface under it left out" : " (no surface found)");
     }
@@ -306,17 +306,21 @@ static vf_status save_view(const char *dir, int index, const vf_image *render,
 }
 
 #define OBJECT_CHECK_SIDE 480 /* the present check's working size (GrabCut's, vf/cutout.h) */
-#define OBJECT_MISSING_MARGIN                                                                      \
-    0.25               /* held-out views missing the object: a warning when their                  \
-                          share exceeds the training views' by this */
-#define REGION_LINK 3  /* the region's cell: this many times the points' median spacing */
-#define REGION_REACH 1 /* cells around a cell with a point that belong to the region */
-#define REGION_MIN_CELLS 24 /* and at least this share of the points' longest extent */
+/* Held-out views missing the object are a warning when their share exceeds the training
+ * views' by this. */
+#define OBJECT_MISSING_MARGIN 0.25
+/* The object's region (below): a cell is REGION_LINK times the points' median spacing and at
+ * least 1/REGION_MIN_CELLS of their longest extent; REGION_REACH cells around a cell with a
+ * point belong to it. */
+#define REGION_LINK 3
+#define REGION_MIN_CELLS 24
+#define REGION_REACH 1
 
 /* The object's region: the cells of a grid over its sparse points that hold one, and their
- * neighbours; a cell is three times the points' median spacing (the link of vf/cutout.h's
- * grouping: its sides without texture have no points). A box around the points took in the
- * quilted bed under banana_apple_photos' banana, which is no plane. */
+ * neighbours (its sides without texture have no points); the spacing's cell is the link of
+ * vf/cutout.h's grouping, and the floor keeps dense patches (the spray can's label) from
+ * leaving a thin shell. A box around the points took in the quilted bed under
+ * banana_apple_photos' banana, which is no plane. */
 typedef struct object_region {
     double lo[3], cell, side; /* side: the points' longest extent */
     int dim[3];
